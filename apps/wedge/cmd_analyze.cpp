@@ -1,0 +1,7 @@
+#include "apps/wedge/commands.h"
+
+namespace wedge::app {
+
+void registerAnalyze(CLI::App&) {}
+
+}  // namespace wedge::app

@@ -1,0 +1,72 @@
+// The contract between sampling and filtering. Filters never see rays, scenes or Embree: they
+// get FrameBuffers (equal-sized named per-pixel planes), ViewGeometry (camera and light frames,
+// as plain numbers), and, where a filter needs them, the individual SampleRecords of a pixel.
+// Given the same buffers a filter produces the same image.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "core/image.h"
+
+namespace wedge {
+
+/// One path sample of the MAAF paper (Sec. 6.2): primary lens ray, one light sample with a shadow
+/// ray, one cosine-weighted bounce lit by its own light sample. World space. 64 bytes.
+struct SampleRecord {
+    Vec3f direct;      // demodulated direct light (irradiance/pi, visibility included), rgb
+    Vec3f indirect;    // demodulated one-bounce indirect radiance, rgb
+    Vec3f lightPoint;  // the sampled point on the light
+    Vec3f bounceDir;   // unit bounce direction; zero when no bounce was traced
+    Vec2f lens;        // lens position on the unit disc (x along camera right, y along camera up)
+    uint32_t light = 0;
+    uint32_t flags = 0;
+    static constexpr uint32_t kHitSurface = 1;
+};
+static_assert(sizeof(SampleRecord) == 64);
+
+/// Camera and light frames the filters use to turn samples into filter coordinates.
+struct ViewGeometry {
+    int width = 0, height = 0;
+    Vec3f cameraPosition, forward, right, up;  // up = image "up" (image y grows along -up)
+    float focalPixels = 1;     // focal length in pixels: (H/2) / tan(fov_y/2)
+    float apertureRadius = 0;  // world
+    float focusDistance = 1;   // world, along forward
+    struct Light {
+        Vec3f center, normal, axisA, axisB;  // axisA/B: orthonormal in the light plane
+        float sigma = 1;                     // Gaussian model of the light: sqrt(area)/2
+    };
+    std::vector<Light> lights;
+
+    /// World size of one pixel at depth z along forward.
+    float pixelFootprint(float depth) const { return depth / focalPixels; }
+    /// Defocus slope of a hit at depth z (NOTES, MYRD14): pixels per unit lens coordinate.
+    float defocusSlope(float depth) const {
+        return apertureRadius * focalPixels * (1.f / std::max(depth, 1e-6f) - 1.f / focusDistance);
+    }
+};
+
+/// Per-pixel planes. Irradiance is demodulated: colour = emission + albedo * (direct + indirect)
+/// holds exactly for the Monte Carlo estimate.
+struct FrameBuffers {
+    int width = 0, height = 0;
+    Image3f color, emission, direct, indirect, albedo, normal, position;
+    Image1f depth, spp, object, variance;  // variance: of the pixel mean's luminance (demodulated light)
+    // Slope statistics of the initial samples (AAF/MAAF prefilter input).
+    Image1f d1;            // mean distance receiver -> light centre over occluded shadow rays
+    Image1f sMax, sMin;    // shadow slopes s1 = max d1/d2min - 1, s2 = min d1/d2max - 1; 0/inf when unoccluded
+    Image1f occluded;      // fraction of shadow rays that hit an occluder
+    Image1f zMin, zMax;    // bounce hit distances
+    Image1f suMin, suMax;  // defocus slopes, pixels per unit lens coordinate
+    Image1f footprint;     // world size of one pixel at the hit
+
+    FrameBuffers() = default;
+    FrameBuffers(int w, int h);
+
+    /// Every plane with its EXR channel names ("direct.R", "normal.X", "depth", ...).
+    void forEachPlane(const std::function<void(const std::string& name, int channels, const float* data)>& fn) const;
+};
+
+}  // namespace wedge

@@ -1,0 +1,53 @@
+// Image<T>: a width x height grid of T, row-major, rows top to bottom (image y grows downward,
+// as in the scene format). The building block of every per-pixel buffer and of the filters.
+#pragma once
+
+#include <cassert>
+#include <cstddef>
+#include <vector>
+
+#include "core/math.h"
+
+namespace wedge {
+
+template <class T>
+class Image {
+public:
+    Image() = default;
+    Image(int width, int height, const T& fill = T{}) : m_width(width), m_height(height), m_data(size_t(width) * height, fill) {}
+
+    int width() const { return m_width; }
+    int height() const { return m_height; }
+    size_t size() const { return m_data.size(); }
+    bool empty() const { return m_data.empty(); }
+
+    T& operator()(int x, int y) {
+        assert(x >= 0 && x < m_width && y >= 0 && y < m_height);
+        return m_data[size_t(y) * m_width + x];
+    }
+    const T& operator()(int x, int y) const {
+        assert(x >= 0 && x < m_width && y >= 0 && y < m_height);
+        return m_data[size_t(y) * m_width + x];
+    }
+    T& operator[](size_t i) { return m_data[i]; }
+    const T& operator[](size_t i) const { return m_data[i]; }
+
+    T* data() { return m_data.data(); }
+    const T* data() const { return m_data.data(); }
+    std::vector<T>& vector() { return m_data; }
+    const std::vector<T>& vector() const { return m_data; }
+
+    void fill(const T& v) { std::fill(m_data.begin(), m_data.end(), v); }
+    bool sameSize(int w, int h) const { return m_width == w && m_height == h; }
+    template <class U>
+    bool sameSize(const Image<U>& o) const { return m_width == o.width() && m_height == o.height(); }
+
+private:
+    int m_width = 0, m_height = 0;
+    std::vector<T> m_data;
+};
+
+using Image1f = Image<float>;
+using Image3f = Image<Vec3f>;
+
+}  // namespace wedge

@@ -1,0 +1,42 @@
+// Parallel loops over image tiles with oneTBB. The thread count is set once per process by
+// ThreadLimit (tbb::global_control); results never depend on it because every reduction that
+// reaches an image is either per pixel or done in a fixed order.
+#pragma once
+
+#include <functional>
+#include <memory>
+
+#include <tbb/blocked_range2d.h>
+#include <tbb/global_control.h>
+#include <tbb/parallel_for.h>
+
+namespace wedge {
+
+/// Limits oneTBB to `threads` worker threads while alive; 0 means all hardware threads.
+class ThreadLimit {
+public:
+    explicit ThreadLimit(int threads);
+    static int current();
+
+private:
+    std::unique_ptr<tbb::global_control> m_control;
+};
+
+/// body(x0, x1, y0, y1) over tiles of an image; tiles are processed in any order.
+template <class Body>
+void parallelTiles(int width, int height, int tile, Body&& body) {
+    tbb::parallel_for(tbb::blocked_range2d<int>(0, height, tile, 0, width, tile),
+                      [&](const tbb::blocked_range2d<int>& r) {
+                          body(r.cols().begin(), r.cols().end(), r.rows().begin(), r.rows().end());
+                      });
+}
+
+/// body(y) for every row, in parallel.
+template <class Body>
+void parallelRows(int height, Body&& body) {
+    tbb::parallel_for(tbb::blocked_range<int>(0, height, 4), [&](const tbb::blocked_range<int>& r) {
+        for (int y = r.begin(); y < r.end(); ++y) body(y);
+    });
+}
+
+}  // namespace wedge

@@ -1,0 +1,86 @@
+// Deterministic sample generation: every random number is a pure function of
+// (seed, pixel, sample index, dimension), so an image never depends on the thread count or on
+// the order in which pixels are processed.
+//
+// Dimensions are consumed in pairs. Each pair is the first two dimensions of the Sobol sequence
+// with hash-based nested uniform (Owen) scrambling and an Owen-scrambled index shuffle, as in
+// Burley, "Practical Hash-based Owen Scrambling", JCGT 9(4), 2020. Each pair is a (0,2)-sequence
+// in base 2: any power-of-two prefix of a pixel's samples is stratified in every elementary
+// interval, and the sequence is progressive, which adaptive sampling needs (it appends samples
+// to a pixel without knowing the final count in advance).
+#pragma once
+
+#include <cstdint>
+
+#include "core/math.h"
+
+namespace wedge {
+
+/// 32-bit integer hash (Wellons' "lowbias32" finaliser): good avalanche, cheap.
+constexpr uint32_t hash32(uint32_t x) {
+    x ^= x >> 16;
+    x *= 0x7feb352dU;
+    x ^= x >> 15;
+    x *= 0x846ca68bU;
+    x ^= x >> 16;
+    return x;
+}
+constexpr uint32_t hashCombine(uint32_t a, uint32_t b) { return hash32(a ^ (hash32(b) + 0x9e3779b9U + (a << 6) + (a >> 2))); }
+
+inline uint32_t reverseBits32(uint32_t x) {
+    x = ((x >> 1) & 0x55555555U) | ((x & 0x55555555U) << 1);
+    x = ((x >> 2) & 0x33333333U) | ((x & 0x33333333U) << 2);
+    x = ((x >> 4) & 0x0f0f0f0fU) | ((x & 0x0f0f0f0fU) << 4);
+    x = ((x >> 8) & 0x00ff00ffU) | ((x & 0x00ff00ffU) << 8);
+    return (x >> 16) | (x << 16);
+}
+
+/// Laine-Karras style permutation that only lets lower bits affect higher ones; applied to the
+/// bit-reversed value it is a nested uniform scramble (Burley 2020, improved constants).
+inline uint32_t laineKarras(uint32_t x, uint32_t seed) {
+    x ^= x * 0x3d20adeaU;
+    x += seed;
+    x *= (seed >> 16) | 1U;
+    x ^= x * 0x05526c56U;
+    x ^= x * 0x53a22864U;
+    return x;
+}
+inline uint32_t nestedUniformScramble(uint32_t x, uint32_t seed) {
+    return reverseBits32(laineKarras(reverseBits32(x), seed));
+}
+
+/// Sobol dimension 0 (van der Corput) and dimension 1 (generator matrix = Pascal matrix mod 2).
+inline uint32_t sobol0(uint32_t index) { return reverseBits32(index); }
+inline uint32_t sobol1(uint32_t index) {
+    uint32_t r = 0;
+    for (uint32_t v = 1U << 31; index; index >>= 1, v ^= v >> 1)
+        if (index & 1U) r ^= v;
+    return r;
+}
+
+inline float toUnitFloat(uint32_t x) {
+    // 24 high bits -> [0, 1), never exactly 1.
+    return float(x >> 8) * 0x1p-24f;
+}
+
+/// The sample generator for one pixel. Cheap to construct; holds no mutable state, so the same
+/// (pixel, index, pair) always yields the same point.
+class PixelSampler {
+public:
+    PixelSampler(uint32_t seed, uint32_t pixelIndex) : m_key(hashCombine(hash32(seed), pixelIndex)) {}
+
+    /// The 2D point of dimension pair `pair` (dimensions 2*pair and 2*pair+1) for sample `index`.
+    Vec2f get2D(uint32_t index, uint32_t pair) const {
+        uint32_t pairKey = hashCombine(m_key, pair);
+        uint32_t shuffled = nestedUniformScramble(index, hash32(pairKey ^ 0xa511e9b3U));
+        uint32_t a = nestedUniformScramble(sobol0(shuffled), hash32(pairKey ^ 0x63d83595U));
+        uint32_t b = nestedUniformScramble(sobol1(shuffled), hash32(pairKey ^ 0x9c0ee1d3U));
+        return {toUnitFloat(a), toUnitFloat(b)};
+    }
+    float get1D(uint32_t index, uint32_t pair) const { return get2D(index, pair).x; }
+
+private:
+    uint32_t m_key;
+};
+
+}  // namespace wedge

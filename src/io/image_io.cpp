@@ -1,0 +1,284 @@
+#include "io/image_io.h"
+
+#include <OpenEXR/ImfChannelList.h>
+#include <OpenEXR/ImfFrameBuffer.h>
+#include <OpenEXR/ImfHeader.h>
+#include <OpenEXR/ImfInputFile.h>
+#include <OpenEXR/ImfOutputFile.h>
+#include <png.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <unistd.h>
+
+#include "core/error.h"
+
+namespace fs = std::filesystem;
+
+namespace wedge::io {
+
+namespace {
+
+/// Writes through `write(tmpPath)` and renames onto `path`; removes the temporary on failure.
+template <class Fn>
+void atomicWrite(const std::string& path, Fn&& write) {
+    static std::atomic<int> counter{0};
+    std::string tmp = path + ".tmp" + std::to_string(getpid()) + "-" + std::to_string(counter++);
+    try {
+        write(tmp);
+        std::error_code ec;
+        fs::rename(tmp, path, ec);
+        if (ec) throw Error(path, "cannot write: " + ec.message());
+    } catch (...) {
+        std::error_code ec;
+        fs::remove(tmp, ec);
+        throw;
+    }
+}
+
+}  // namespace
+
+std::string extension(const std::string& path) {
+    std::string e = fs::path(path).extension().string();
+    std::transform(e.begin(), e.end(), e.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+    return e;
+}
+
+void checkOutputPath(const std::string& path, const std::vector<std::string>& allowed) {
+    std::string e = extension(path);
+    if (std::find(allowed.begin(), allowed.end(), e) == allowed.end()) {
+        std::string list;
+        for (auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
+        throw Error(path, "unsupported output format '" + e + "' (expected " + list + ")");
+    }
+    fs::path dir = fs::path(path).parent_path();
+    if (!dir.empty() && !fs::is_directory(dir)) throw Error(path, "output directory does not exist");
+}
+
+float srgbEncode(float v) {
+    v = std::clamp(v, 0.f, 1.f);
+    return v <= 0.0031308f ? 12.92f * v : 1.055f * std::pow(v, 1.f / 2.4f) - 0.055f;
+}
+float srgbDecode(float v) { return v <= 0.04045f ? v / 12.92f : std::pow((v + 0.055f) / 1.055f, 2.4f); }
+
+// --- EXR -------------------------------------------------------------------------------------
+
+void writeExr(const std::string& path, int width, int height, const std::vector<ExrChannel>& channels) {
+    atomicWrite(path, [&](const std::string& tmp) {
+        try {
+            Imf::Header header(width, height);
+            header.compression() = Imf::ZIP_COMPRESSION;
+            Imf::FrameBuffer fb;
+            for (const auto& c : channels) {
+                header.channels().insert(c.name, Imf::Channel(Imf::FLOAT));
+                fb.insert(c.name, Imf::Slice(Imf::FLOAT, (char*)c.data, sizeof(float) * c.stride,
+                                             sizeof(float) * c.stride * size_t(width)));
+            }
+            Imf::OutputFile file(tmp.c_str(), header);
+            file.setFrameBuffer(fb);
+            file.writePixels(height);
+        } catch (const Error&) {
+            throw;
+        } catch (const std::exception& e) {
+            throw Error(path, std::string("cannot write EXR: ") + e.what());
+        }
+    });
+}
+
+ExrImage readExr(const std::string& path) {
+    if (!fs::is_regular_file(path)) throw Error(path, "no such file");
+    try {
+        Imf::InputFile file(path.c_str());
+        Imath::Box2i dw = file.header().dataWindow();
+        ExrImage img;
+        img.width = dw.max.x - dw.min.x + 1;
+        img.height = dw.max.y - dw.min.y + 1;
+        Imf::FrameBuffer fb;
+        for (auto it = file.header().channels().begin(); it != file.header().channels().end(); ++it) {
+            auto& v = img.channels[it.name()];
+            v.assign(size_t(img.width) * img.height, 0.f);
+            char* base = (char*)(v.data() - dw.min.x - size_t(dw.min.y) * img.width);
+            fb.insert(it.name(), Imf::Slice(Imf::FLOAT, base, sizeof(float), sizeof(float) * size_t(img.width)));
+        }
+        file.setFrameBuffer(fb);
+        file.readPixels(dw.min.y, dw.max.y);
+        return img;
+    } catch (const std::exception& e) {
+        throw Error(path, std::string("not a readable EXR file: ") + e.what());
+    }
+}
+
+// --- PNG -------------------------------------------------------------------------------------
+
+namespace {
+
+void writePngRgb8(const std::string& path, int width, int height, const std::vector<unsigned char>& rgb) {
+    atomicWrite(path, [&](const std::string& tmp) {
+        FILE* fp = std::fopen(tmp.c_str(), "wb");
+        if (!fp) throw Error(path, std::string("cannot open for writing: ") + std::strerror(errno));
+        png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
+        png_infop info = png_create_info_struct(png);
+        if (setjmp(png_jmpbuf(png))) {
+            png_destroy_write_struct(&png, &info);
+            std::fclose(fp);
+            throw Error(path, "libpng failed to write the image");
+        }
+        png_init_io(png, fp);
+        png_set_IHDR(png, info, width, height, 8, PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE,
+                     PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
+        png_set_compression_level(png, 6);
+        png_write_info(png, info);
+        for (int y = 0; y < height; ++y) png_write_row(png, (png_const_bytep)&rgb[size_t(y) * width * 3]);
+        png_write_end(png, nullptr);
+        png_destroy_write_struct(&png, &info);
+        if (std::fclose(fp) != 0) throw Error(path, "cannot finish writing");
+    });
+}
+
+unsigned char toByte(float encoded) { return (unsigned char)std::clamp(int(encoded * 255.f + 0.5f), 0, 255); }
+
+}  // namespace
+
+void writePng(const std::string& path, const Image3f& linear) {
+    std::vector<unsigned char> rgb(linear.size() * 3);
+    for (size_t i = 0; i < linear.size(); ++i)
+        for (int c = 0; c < 3; ++c) rgb[3 * i + c] = toByte(srgbEncode(linear[i][c]));
+    writePngRgb8(path, linear.width(), linear.height(), rgb);
+}
+
+void writePngHeat(const std::string& path, const Image1f& values, float lo, float hi) {
+    // A perceptually ordered ramp (dark blue -> teal -> yellow), close to viridis at 5 stops.
+    static const Vec3f stops[5] = {{0.267f, 0.005f, 0.329f}, {0.231f, 0.322f, 0.545f}, {0.129f, 0.569f, 0.549f},
+                                   {0.369f, 0.788f, 0.384f}, {0.993f, 0.906f, 0.144f}};
+    std::vector<unsigned char> rgb(values.size() * 3);
+    for (size_t i = 0; i < values.size(); ++i) {
+        float v = values[i];
+        Vec3f c(1.f, 0.f, 1.f);  // magenta marks NaN
+        if (std::isfinite(v)) {
+            float t = hi > lo ? std::clamp((v - lo) / (hi - lo), 0.f, 1.f) : 0.f;
+            float f = t * 4.f;
+            int k = std::min(3, int(f));
+            float a = f - k;
+            c = stops[k] * (1 - a) + stops[k + 1] * a;
+        }
+        for (int ch = 0; ch < 3; ++ch) rgb[3 * i + ch] = toByte(c[ch]);
+    }
+    writePngRgb8(path, values.width(), values.height(), rgb);
+}
+
+Image3f readPng(const std::string& path) {
+    FILE* fp = std::fopen(path.c_str(), "rb");
+    if (!fp) throw Error(path, std::string("cannot open: ") + std::strerror(errno));
+    unsigned char sig[8];
+    if (std::fread(sig, 1, 8, fp) != 8 || png_sig_cmp(sig, 0, 8)) {
+        std::fclose(fp);
+        throw Error(path, "not a PNG file");
+    }
+    png_structp png = png_create_read_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
+    png_infop info = png_create_info_struct(png);
+    std::vector<unsigned char> pixels;
+    if (setjmp(png_jmpbuf(png))) {
+        png_destroy_read_struct(&png, &info, nullptr);
+        std::fclose(fp);
+        throw Error(path, "corrupt PNG file");
+    }
+    png_init_io(png, fp);
+    png_set_sig_bytes(png, 8);
+    png_read_info(png, info);
+    png_set_strip_16(png);
+    png_set_palette_to_rgb(png);
+    png_set_gray_to_rgb(png);
+    png_set_strip_alpha(png);
+    png_set_expand_gray_1_2_4_to_8(png);
+    png_read_update_info(png, info);
+    int w = int(png_get_image_width(png, info)), h = int(png_get_image_height(png, info));
+    size_t rowBytes = png_get_rowbytes(png, info);
+    pixels.resize(rowBytes * h);
+    std::vector<png_bytep> rows(h);
+    for (int y = 0; y < h; ++y) rows[y] = &pixels[rowBytes * y];
+    png_read_image(png, rows.data());
+    png_destroy_read_struct(&png, &info, nullptr);
+    std::fclose(fp);
+    Image3f img(w, h);
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x)
+            for (int c = 0; c < 3; ++c) img(x, y)[c] = srgbDecode(pixels[rowBytes * y + 3 * x + c] / 255.f);
+    return img;
+}
+
+// --- PFM -------------------------------------------------------------------------------------
+
+void writePfm(const std::string& path, const Image3f& img) {
+    atomicWrite(path, [&](const std::string& tmp) {
+        std::ofstream out(tmp, std::ios::binary);
+        if (!out) throw Error(path, "cannot open for writing");
+        out << "PF\n" << img.width() << " " << img.height() << "\n-1.0\n";  // negative scale: little-endian
+        for (int y = img.height() - 1; y >= 0; --y)  // PFM stores rows bottom to top
+            for (int x = 0; x < img.width(); ++x) {
+                float rgb[3] = {img(x, y).x, img(x, y).y, img(x, y).z};
+                out.write(reinterpret_cast<const char*>(rgb), sizeof(rgb));
+            }
+        if (!out) throw Error(path, "write failed");
+    });
+}
+
+Image3f readPfm(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw Error(path, "cannot open");
+    std::string magic;
+    int w = 0, h = 0;
+    float scale = 0;
+    in >> magic >> w >> h >> scale;
+    in.get();
+    if (!in || (magic != "PF" && magic != "Pf") || w <= 0 || h <= 0 || scale == 0)
+        throw Error(path, "not a PFM file (bad header)");
+    if (scale > 0) throw Error(path, "big-endian PFM is not supported");
+    int channels = magic == "PF" ? 3 : 1;
+    std::vector<float> raw(size_t(w) * h * channels);
+    in.read(reinterpret_cast<char*>(raw.data()), raw.size() * sizeof(float));
+    if (!in) throw Error(path, "truncated PFM data");
+    Image3f img(w, h);
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+            const float* p = &raw[(size_t(h - 1 - y) * w + x) * channels];
+            img(x, y) = channels == 3 ? Vec3f(p[0], p[1], p[2]) : Vec3f(p[0]);
+        }
+    return img;
+}
+
+// --- by extension ----------------------------------------------------------------------------
+
+Image3f readColor(const std::string& path) {
+    if (!fs::is_regular_file(path)) throw Error(path, "no such file");
+    std::string e = extension(path);
+    if (e == ".png") return readPng(path);
+    if (e == ".pfm") return readPfm(path);
+    if (e == ".exr") {
+        ExrImage exr = readExr(path);
+        for (const char* c : {"R", "G", "B"})
+            if (!exr.channels.count(c)) throw Error(path, std::string("EXR has no channel ") + c);
+        Image3f img(exr.width, exr.height);
+        for (size_t i = 0; i < img.size(); ++i)
+            img[i] = {exr.channels["R"][i], exr.channels["G"][i], exr.channels["B"][i]};
+        return img;
+    }
+    throw Error(path, "unsupported image format '" + e + "' (expected .exr, .png or .pfm)");
+}
+
+void writeColor(const std::string& path, const Image3f& linear) {
+    std::string e = extension(path);
+    if (e == ".png") return writePng(path, linear);
+    if (e == ".pfm") return writePfm(path, linear);
+    if (e == ".exr") {
+        const float* base = &linear[0].x;
+        return writeExr(path, linear.width(), linear.height(), {{"R", base, 3}, {"G", base + 1, 3}, {"B", base + 2, 3}});
+    }
+    throw Error(path, "unsupported image format '" + e + "' (expected .exr, .png or .pfm)");
+}
+
+}  // namespace wedge::io

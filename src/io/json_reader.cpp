@@ -1,0 +1,139 @@
+#include "io/json_reader.h"
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "core/error.h"
+
+namespace wedge::io {
+
+namespace {
+const char* typeName(const nlohmann::json& v) {
+    if (v.is_object()) return "an object";
+    if (v.is_array()) return "an array";
+    if (v.is_string()) return "a string";
+    if (v.is_boolean()) return "a boolean";
+    if (v.is_number()) return "a number";
+    if (v.is_null()) return "null";
+    return "an unknown value";
+}
+}  // namespace
+
+JsonNode::JsonNode(const nlohmann::json& value, std::string file, std::string path)
+    : m_value(value), m_file(std::move(file)), m_path(std::move(path)) {}
+
+nlohmann::json JsonNode::parseFile(const std::string& file) {
+    if (!std::filesystem::exists(file)) throw Error(file, "no such file");
+    if (std::filesystem::is_directory(file)) throw Error(file, "is a directory, expected a JSON scene file");
+    std::ifstream in(file);
+    if (!in) throw Error(file, "cannot open for reading");
+    std::stringstream ss;
+    ss << in.rdbuf();
+    std::string text = ss.str();
+    try {
+        return nlohmann::json::parse(text);
+    } catch (const nlohmann::json::parse_error& e) {
+        // Translate the byte offset into line:column.
+        size_t offset = std::min(e.byte > 0 ? e.byte - 1 : 0, text.size());
+        int line = 1, col = 1;
+        for (size_t i = 0; i < offset; ++i) {
+            if (text[i] == '\n') { ++line; col = 1; } else { ++col; }
+        }
+        std::string what = e.what();
+        auto pos = what.find("syntax error");
+        throw Error(file + ":" + std::to_string(line) + ":" + std::to_string(col),
+                    "invalid JSON: " + (pos != std::string::npos ? what.substr(pos) : what));
+    }
+}
+
+std::string JsonNode::where() const { return m_path.empty() ? m_file : m_file + ": " + m_path; }
+void JsonNode::fail(const std::string& what) const { throw Error(where(), what); }
+
+bool JsonNode::has(const std::string& key) const { return m_value.is_object() && m_value.contains(key); }
+
+JsonNode JsonNode::member(const std::string& key) const {
+    std::string p = m_path.empty() ? key : m_path + "." + key;
+    if (!m_value.is_object()) fail(std::string("expected an object, got ") + typeName(m_value));
+    auto it = m_value.find(key);
+    if (it == m_value.end()) throw Error(m_file + ": " + p, "missing required field");
+    m_seen.insert(key);
+    return JsonNode(*it, m_file, p);
+}
+
+JsonNode JsonNode::operator[](const std::string& key) const { return member(key); }
+
+std::optional<JsonNode> JsonNode::optional(const std::string& key) const {
+    if (!m_value.is_object()) fail(std::string("expected an object, got ") + typeName(m_value));
+    if (!m_value.contains(key)) return std::nullopt;
+    return member(key);
+}
+
+size_t JsonNode::size() const {
+    if (!m_value.is_array()) fail(std::string("expected an array, got ") + typeName(m_value));
+    return m_value.size();
+}
+
+JsonNode JsonNode::operator[](size_t i) const {
+    size();  // type check
+    return JsonNode(m_value[i], m_file, m_path + "[" + std::to_string(i) + "]");
+}
+
+std::vector<std::string> JsonNode::keys() const {
+    if (!m_value.is_object()) fail(std::string("expected an object, got ") + typeName(m_value));
+    std::vector<std::string> k;
+    for (auto it = m_value.begin(); it != m_value.end(); ++it) k.push_back(it.key());
+    return k;
+}
+
+double JsonNode::number() const {
+    if (!m_value.is_number()) fail(std::string("expected a number, got ") + typeName(m_value));
+    double v = m_value.get<double>();
+    if (!std::isfinite(v)) fail("expected a finite number");
+    return v;
+}
+double JsonNode::positive() const {
+    if (!m_value.is_number() || !(m_value.get<double>() > 0)) fail("expected a positive number");
+    return number();
+}
+double JsonNode::nonNegative() const {
+    if (!m_value.is_number() || !(m_value.get<double>() >= 0)) fail("expected a non-negative number");
+    return number();
+}
+int JsonNode::integer() const {
+    if (!m_value.is_number_integer()) fail(std::string("expected an integer, got ") + typeName(m_value));
+    auto v = m_value.get<long long>();
+    if (v < INT32_MIN || v > INT32_MAX) fail("integer out of range");
+    return int(v);
+}
+bool JsonNode::boolean() const {
+    if (!m_value.is_boolean()) fail(std::string("expected true or false, got ") + typeName(m_value));
+    return m_value.get<bool>();
+}
+std::string JsonNode::string() const {
+    if (!m_value.is_string()) fail(std::string("expected a string, got ") + typeName(m_value));
+    return m_value.get<std::string>();
+}
+Vec3f JsonNode::vec3() const {
+    if (!m_value.is_array() || m_value.size() != 3) fail("expected an array of 3 numbers");
+    Vec3f v;
+    for (int i = 0; i < 3; ++i) v[i] = float((*this)[size_t(i)].number());
+    return v;
+}
+Vec3f JsonNode::color() const {
+    Vec3f v = vec3();
+    if (v.x < 0 || v.y < 0 || v.z < 0) fail("expected non-negative colour components");
+    return v;
+}
+
+void JsonNode::finish() const {
+    if (!m_value.is_object()) return;
+    for (auto it = m_value.begin(); it != m_value.end(); ++it)
+        if (!m_seen.count(it.key())) {
+            std::string p = m_path.empty() ? it.key() : m_path + "." + it.key();
+            throw Error(m_file + ": " + p, "unknown key");
+        }
+}
+
+}  // namespace wedge::io

@@ -1,0 +1,30 @@
+// Internal: the per-method entry points behind render(). Each receives a ready PathSampler and
+// fills a RenderResult (colour, buffers, stage times, sample and ray counts).
+#pragma once
+
+#include "core/progress.h"
+#include "render/path_sampler.h"
+#include "render/pixel_stats.h"
+#include "render/renderer.h"
+
+namespace wedge::render {
+
+struct MethodContext {
+    const scene::Scene& scene;
+    const RenderOptions& options;
+    const PathSampler& sampler;
+    ViewGeometry view;
+    int spp;  // the method's base sample count
+};
+
+void renderMc(const MethodContext& ctx, RenderResult& result);
+void renderAaf(const MethodContext& ctx, RenderResult& result);
+void renderMaaf(const MethodContext& ctx, RenderResult& result);
+void renderAtrous(const MethodContext& ctx, RenderResult& result);
+
+/// Stores every pixel's statistics into `fb`.
+void storeStats(const Image<PixelStats>& stats, const ViewGeometry& view, FrameBuffers& fb);
+/// Average samples per pixel of `fb.spp`.
+double averageSpp(const FrameBuffers& fb);
+
+}  // namespace wedge::render

@@ -1,0 +1,70 @@
+#include "render/output.h"
+
+#include <cstdio>
+#include <sstream>
+
+#include "io/image_io.h"
+
+namespace wedge::render {
+
+const std::vector<std::string>& outputExtensions() {
+    static const std::vector<std::string> ext = {".exr", ".png", ".pfm"};
+    return ext;
+}
+
+void writeOutput(const RenderResult& r, const std::string& path) {
+    std::string e = io::extension(path);
+    if (e != ".exr") return io::writeColor(path, r.color);
+    // Final colour as R, G, B, then every buffer under its own name (pbrt's GBufferFilm style).
+    std::vector<io::ExrChannel> channels;
+    const float* c = &r.color[0].x;
+    channels.push_back({"R", c, 3});
+    channels.push_back({"G", c + 1, 3});
+    channels.push_back({"B", c + 2, 3});
+    r.buffers.forEachPlane([&](const std::string& name, int n, const float* data) {
+        static const char* rgb[] = {"R", "G", "B"};
+        static const char* xyz[] = {"X", "Y", "Z"};
+        bool vector = name == "normal" || name == "position";
+        if (n == 1) channels.push_back({name, data, 1});
+        else
+            for (int k = 0; k < n; ++k) channels.push_back({name + "." + (vector ? xyz[k] : rgb[k]), data + k, n});
+    });
+    io::writeExr(path, r.color.width(), r.color.height(), channels);
+}
+
+nlohmann::json statsJson(const RenderResult& r, const std::string& sceneName) {
+    nlohmann::json j;
+    j["scene"] = sceneName;
+    j["method"] = r.method;
+    j["resolution"] = {r.color.width(), r.color.height()};
+    j["spp_average"] = r.sppAverage;
+    j["rays"] = r.rays;
+    j["threads"] = r.threads;
+    nlohmann::json sec = nlohmann::json::object();
+    for (auto& [stage, s] : r.seconds.stages()) sec[stage] = s;
+    j["seconds"] = sec;
+    double sampling = r.seconds.get("sampling");
+    j["rays_per_second"] = sampling > 0 ? double(r.rays) / sampling : 0.0;
+    for (auto& [k, v] : r.extra) j[k] = v;
+    return j;
+}
+
+std::string timingSummary(const RenderResult& r) {
+    std::ostringstream os;
+    char buf[256];
+    std::snprintf(buf, sizeof buf, "%s  %dx%d  %.1f spp average  %.2f Mrays  %d threads\n", r.method.c_str(),
+                  r.color.width(), r.color.height(), r.sppAverage, double(r.rays) * 1e-6, r.threads);
+    os << buf;
+    for (auto& [stage, s] : r.seconds.stages()) {
+        std::snprintf(buf, sizeof buf, "  %-22s %8.3f s\n", stage.c_str(), s);
+        os << buf;
+    }
+    double sampling = r.seconds.get("sampling");
+    if (sampling > 0) {
+        std::snprintf(buf, sizeof buf, "  %-22s %8.2f Mrays/s\n", "sampling throughput", double(r.rays) / sampling * 1e-6);
+        os << buf;
+    }
+    return os.str();
+}
+
+}  // namespace wedge::render

@@ -1,0 +1,19 @@
+// Files a render produces: the image in the format its extension names (.exr with every buffer
+// as named channels, .png tone-mapped, .pfm colour), the --stats JSON and the timing summary.
+#pragma once
+
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "render/renderer.h"
+
+namespace wedge::render {
+
+/// The output formats `-o` accepts.
+const std::vector<std::string>& outputExtensions();
+void writeOutput(const RenderResult& result, const std::string& path);
+nlohmann::json statsJson(const RenderResult& result, const std::string& sceneName);
+std::string timingSummary(const RenderResult& result);
+
+}  // namespace wedge::render

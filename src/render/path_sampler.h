@@ -1,0 +1,71 @@
+// The path sample of the MAAF paper (Sec. 6.2, after MYRD14): a primary ray through a lens
+// sample; at its hit one light sample with a shadow ray (direct light); one cosine-weighted
+// diffuse bounce whose hit is lit by its own light sample and shadow ray (one bounce of
+// indirect light). Emission counts only where the camera sees an emitter, never at bounce
+// hits, so nothing is counted twice. Random numbers come from PixelSampler, so a sample depends
+// only on (seed, pixel, sample index).
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "core/buffers.h"
+#include "core/sampler.h"
+#include "render/camera.h"
+#include "scene/scene.h"
+
+namespace wedge::render {
+
+/// Everything one path sample produced: the record the filters see, plus the per-sample facts
+/// the pixel statistics (slopes, G-buffer) are built from.
+struct TracedSample {
+    SampleRecord record;
+    bool hit = false;
+    Vec3f emission{0.f}, albedo{0.f}, normal{0.f}, position{0.f};
+    float depth = 0;
+    uint32_t object = 0;
+    // Shadow ray of the primary hit (only when the light faced the receiver).
+    bool shadowTested = false, occluded = false;
+    float d1 = 0;                  // receiver -> light centre
+    float tNear = kInf, tFar = 0;  // occluder span along the shadow ray (span queries only)
+    // Bounce.
+    bool bounceHit = false;
+    float bounceDistance = kInf;
+    uint32_t rays = 0;
+};
+
+class PathSampler {
+public:
+    /// Dimension pairs of PixelSampler, in order of use.
+    enum Pair : uint32_t { kPixel = 0, kLens = 1, kLight = 2, kBounce = 3, kBounceLight = 4, kChoice = 5 };
+
+    PathSampler(const scene::Scene& scene, const Camera& camera, bool indirect, uint32_t seed);
+
+    /// Traces sample `index` of pixel (x, y). With `span`, the primary shadow ray collects the
+    /// nearest and farthest occluder (all hits along it) instead of stopping at the first.
+    TracedSample trace(int x, int y, uint32_t index, bool span) const;
+
+    const Camera& camera() const { return m_camera; }
+    const scene::Scene& scene() const { return m_scene; }
+    ViewGeometry view() const;
+
+private:
+    struct LightSample {
+        Vec3f point;
+        Vec3f irradiance;  // E: radiance * cos * cos / r^2 / pdf, zero if facing away
+        Vec3f toLight;     // unit
+        float distance;
+        uint32_t light;
+    };
+    LightSample sampleLight(const Vec3f& p, const Vec3f& n, Vec2f u, float choice) const;
+    Vec3f offset(const Vec3f& p, const Vec3f& n) const { return p + n * m_epsilon; }
+
+    const scene::Scene& m_scene;
+    Camera m_camera;
+    bool m_indirect;
+    uint32_t m_seed;
+    float m_epsilon;
+    std::vector<float> m_lightCdf;  // light choice proportional to power
+};
+
+}  // namespace wedge::render

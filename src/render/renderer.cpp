@@ -1,0 +1,68 @@
+#include "render/renderer.h"
+
+#include "core/error.h"
+#include "core/parallel.h"
+#include "render/methods.h"
+#include "render/sampling.h"
+
+namespace wedge::render {
+
+std::vector<std::string> methods() { return {"mc", "aaf", "maaf", "atrous"}; }
+
+void storeStats(const Image<PixelStats>& stats, const ViewGeometry& view, FrameBuffers& fb) {
+    parallelRows(stats.height(), [&](int y) {
+        for (int x = 0; x < stats.width(); ++x) stats(x, y).store(fb, x, y, view);
+    });
+}
+
+double averageSpp(const FrameBuffers& fb) {
+    double s = 0;
+    for (size_t i = 0; i < fb.spp.size(); ++i) s += fb.spp[i];
+    return fb.spp.empty() ? 0 : s / double(fb.spp.size());
+}
+
+void renderMc(const MethodContext& ctx, RenderResult& result) {
+    const ViewGeometry& view = ctx.view;
+    Image<PixelStats> stats(view.width, view.height);
+    Progress progress("mc sampling", uint64_t(view.width) * view.height * ctx.spp, !ctx.options.quiet);
+    Timer t;
+    result.rays = samplePixels(
+        ctx.sampler, stats, view, [&](int, int) { return SampleRange{0, uint32_t(ctx.spp)}; }, false, true,
+        [](int, int, const TracedSample&) {}, &progress);
+    progress.done();
+    storeStats(stats, view, result.buffers);
+    result.seconds.add("sampling", t.seconds());
+    result.color = result.buffers.color;
+}
+
+RenderResult render(const scene::Scene& scene, const RenderOptions& options) {
+    const auto known = methods();
+    if (std::find(known.begin(), known.end(), options.method) == known.end()) {
+        std::string list;
+        for (auto& m : known) list += (list.empty() ? "" : ", ") + m;
+        throw Error("--method", "unknown method '" + options.method + "' (expected one of " + list + ")");
+    }
+    const scene::SceneDesc& desc = scene.desc();
+    uint32_t seed = options.seed.value_or(desc.render.seed);
+    int spp = options.spp.value_or(options.method == "mc" ? desc.render.spp : 16);
+    if (spp <= 0) throw Error("--spp", "expected a positive number of samples per pixel");
+
+    Timer total;
+    Camera camera(desc.camera);
+    PathSampler sampler(scene, camera, desc.render.indirect, seed);
+    MethodContext ctx{scene, options, sampler, sampler.view(), spp};
+
+    RenderResult result;
+    result.method = options.method;
+    result.threads = ThreadLimit::current();
+    result.buffers = FrameBuffers(desc.camera.width, desc.camera.height);
+    if (options.method == "mc") renderMc(ctx, result);
+    else if (options.method == "aaf") renderAaf(ctx, result);
+    else if (options.method == "maaf") renderMaaf(ctx, result);
+    else renderAtrous(ctx, result);
+    result.sppAverage = averageSpp(result.buffers);
+    result.seconds.add("total", total.seconds());
+    return result;
+}
+
+}  // namespace wedge::render

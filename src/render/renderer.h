@@ -1,0 +1,48 @@
+// One entry point for every method: render(scene, options) -> RenderResult. Methods share the
+// path sampler and the buffers; `mc` is plain Monte Carlo, the ground truth at high spp.
+#pragma once
+
+#include <map>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "core/buffers.h"
+#include "core/timer.h"
+#include "scene/scene.h"
+
+namespace wedge::render {
+
+struct RenderOptions {
+    std::string method = "mc";
+    std::optional<int> spp;          // mc: samples per pixel; aaf/maaf: initial samples per pixel
+    std::optional<uint32_t> seed;    // default: the scene's render.seed
+    bool quiet = false;
+    int maxExtraSpp = -1;            // aaf/maaf adaptive cap per pixel; -1 = method default
+    int maafComponents = 5;          // 2N-1 filters per 2D/3D subspace
+    bool maafFocalFallback = true;   // fall back to the central filter where the defocus slope changes sign
+    // à-trous
+    int atrousIterations = 5;
+    float atrousSigmaColor = 4.f, atrousSigmaNormal = 0.1f, atrousSigmaPosition = 1.f;
+    bool atrousVarianceGuided = true;
+    std::string aovDir;              // debug maps (PNG) when non-empty
+};
+
+struct RenderResult {
+    std::string method;
+    Image3f color;
+    FrameBuffers buffers;
+    StageTimes seconds;  // per stage, "total" added at the end
+    double sppAverage = 0;
+    uint64_t rays = 0;
+    int threads = 0;
+    std::vector<std::pair<std::string, double>> extra;  // method-specific figures for --stats
+};
+
+/// The methods `render` knows, in the order `wedge render --help` lists them.
+std::vector<std::string> methods();
+
+RenderResult render(const scene::Scene& scene, const RenderOptions& options);
+
+}  // namespace wedge::render

@@ -1,0 +1,91 @@
+// The scene description: what a scene file says, after validation and after meshes are loaded
+// and transformed into world space. Plain data; Embree never appears here (scene.h owns it),
+// so the rasterizer and the tests can use descriptions directly.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "core/math.h"
+
+namespace wedge::scene {
+
+struct Material {
+    std::string name;
+    Vec3f albedo{0.8f};
+    Vec3f emission{0.f};
+    /// Procedural texture for the rasterizer ("checker" or empty); the ray tracer ignores it.
+    std::string texture;
+    float textureScale = 1.f;  // checker cells per world unit
+    bool isEmitter() const { return maxComponent(emission) > 0; }
+};
+
+struct CameraDesc {
+    Vec3f position{0, 0, 1}, lookAt{0, 0, 0}, up{0, 1, 0};
+    float fovY = 45.f;  // degrees, full vertical angle
+    int width = 512, height = 512;
+    float apertureRadius = 0.f;  // world units; 0 = pinhole
+    float focusDistance = 1.f;   // along forward
+    float shutterOpen = 0.f, shutterClose = 1.f;
+};
+
+/// A parallelogram area light emitting `radiance` from the side of normalize(cross(edge1, edge2)).
+struct ParallelogramLight {
+    Vec3f corner, edge1, edge2, radiance;
+
+    Vec3f normal() const { return normalize(cross(edge1, edge2)); }
+    float area() const { return length(cross(edge1, edge2)); }
+    Vec3f center() const { return corner + (edge1 + edge2) * 0.5f; }
+    Vec3f pointAt(float u, float v) const { return corner + edge1 * u + edge2 * v; }
+    /// Standard deviation of the Gaussian the analysis treats the light as (NOTES: sqrt(area)/2).
+    float sigma() const { return 0.5f * std::sqrt(area()); }
+};
+
+/// Triangles in world space at shutter open; `velocity` moves the whole mesh over the shutter.
+struct TriangleMesh {
+    std::string name;
+    std::vector<Vec3f> positions;
+    std::vector<uint32_t> indices;      // 3 per triangle
+    std::vector<uint32_t> materialIds;  // 1 per triangle
+    Vec3f velocity{0.f};
+    size_t triangleCount() const { return indices.size() / 3; }
+};
+
+struct Sphere {
+    Vec3f center;
+    float radius = 1.f;
+    uint32_t material = 0;
+    Vec3f velocity{0.f};
+};
+
+struct RenderSettings {
+    int spp = 16;
+    uint32_t seed = 0;
+    bool indirect = true;
+};
+
+struct SceneDesc {
+    std::string file;  // the scene file, for messages
+    CameraDesc camera;
+    std::vector<Material> materials;
+    std::vector<ParallelogramLight> lights;
+    std::vector<TriangleMesh> meshes;
+    std::vector<Sphere> spheres;
+    RenderSettings render;
+
+    size_t triangleCount() const {
+        size_t n = 0;
+        for (auto& m : meshes) n += m.triangleCount();
+        return n;
+    }
+    bool hasMotion() const;
+};
+
+/// Appends the two triangles of a parallelogram (corner, corner+e1, corner+e1+e2, corner+e2),
+/// wound so that their normal is cross(e1, e2).
+void appendQuad(TriangleMesh& mesh, const Vec3f& corner, const Vec3f& e1, const Vec3f& e2, uint32_t material);
+/// Appends the 12 outward-facing triangles of an axis-aligned box.
+void appendBox(TriangleMesh& mesh, const Vec3f& lo, const Vec3f& hi, uint32_t material);
+
+}  // namespace wedge::scene

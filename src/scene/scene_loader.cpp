@@ -1,0 +1,394 @@
+#include "scene/scene_loader.h"
+
+#include <tiny_obj_loader.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
+
+#include "core/error.h"
+#include "io/json_reader.h"
+
+#ifndef WEDGE_SCENES_DIR
+#define WEDGE_SCENES_DIR "scenes"
+#endif
+
+namespace fs = std::filesystem;
+
+namespace wedge::scene {
+
+using io::JsonNode;
+
+namespace {
+
+constexpr float kDegToRad = kPi / 180.f;
+
+Vec3f readScale(JsonNode node) {
+    if (node.isArray()) {
+        Vec3f s = node.vec3();
+        if (s.x <= 0 || s.y <= 0 || s.z <= 0) node.fail("expected positive scale factors");
+        return s;
+    }
+    return Vec3f(float(node.positive()));
+}
+
+/// Accepts a 4-vertex face as a parallelogram light if v2 = v0 + e1 + e2 up to rounding.
+bool asParallelogram(const Vec3f v[4], ParallelogramLight& light) {
+    Vec3f e1 = v[1] - v[0], e2 = v[3] - v[0];
+    float scale = std::max(length(e1), length(e2));
+    if (scale <= 0 || length(cross(e1, e2)) <= 1e-8f * scale * scale) return false;
+    if (length(v[0] + e1 + e2 - v[2]) > 1e-3f * scale) return false;
+    light.corner = v[0];
+    light.edge1 = e1;
+    light.edge2 = e2;
+    return true;
+}
+
+struct Transform {
+    Vec3f scale{1.f}, translate{0.f}, axis{0, 1, 0};
+    float radians = 0;
+    Vec3f apply(const Vec3f& p) const {
+        Vec3f q = p * scale;
+        if (radians != 0) q = rotate(q, axis, radians);
+        return q + translate;
+    }
+};
+
+class SceneParser {
+public:
+    SceneParser(std::string file, std::string baseDir) : m_file(std::move(file)), m_baseDir(std::move(baseDir)) {}
+
+    SceneDesc parse(const nlohmann::json& doc) {
+        JsonNode root(doc, m_file, "");
+        if (!root.isObject()) root.fail("expected a JSON object at the top level");
+        m_desc.file = m_file;
+        if (auto v = root.optional("version"))
+            if (v->integer() != 1) v->fail("unsupported scene version (expected 1)");
+        parseCamera(root["camera"]);
+        if (auto mats = root.optional("materials")) parseMaterials(*mats);
+        if (auto lights = root.optional("lights")) parseLights(*lights);
+        parseObjects(root["objects"]);
+        if (auto r = root.optional("render")) parseRender(*r);
+        root.finish();
+        if (m_desc.lights.empty())
+            throw Error(m_file + ": lights", "the scene has no light (add a parallelogram light)");
+        if (m_desc.meshes.empty() && m_desc.spheres.empty()) throw Error(m_file + ": objects", "the scene has no geometry");
+        return std::move(m_desc);
+    }
+
+private:
+    void parseCamera(JsonNode c) {
+        CameraDesc& cam = m_desc.camera;
+        cam.position = c["position"].vec3();
+        cam.lookAt = c["look_at"].vec3();
+        cam.up = c["up"].vec3();
+        Vec3f forward = cam.lookAt - cam.position;
+        if (length(forward) <= 0) c["look_at"].fail("must differ from camera.position");
+        if (length(cross(normalize(forward), cam.up)) < 1e-6f) c["up"].fail("must not be parallel to the view direction");
+        JsonNode fov = c["fov_y"];
+        cam.fovY = float(fov.positive());
+        if (cam.fovY >= 180.f) fov.fail("expected an angle in degrees below 180");
+        JsonNode res = c["resolution"];
+        if (res.size() != 2) res.fail("expected [width, height]");
+        for (int i = 0; i < 2; ++i) {
+            JsonNode r = res[size_t(i)];
+            int v = r.integer();
+            if (v <= 0) r.fail("expected a positive resolution");
+            if (v > 16384) r.fail("resolution above 16384 is not supported");
+            (i == 0 ? cam.width : cam.height) = v;
+        }
+        if (auto a = c.optional("aperture_radius")) cam.apertureRadius = float(a->nonNegative());
+        cam.focusDistance = length(forward);
+        if (auto f = c.optional("focus_distance")) cam.focusDistance = float(f->positive());
+        if (auto s = c.optional("shutter")) {
+            if (s->size() != 2) s->fail("expected [open, close]");
+            cam.shutterOpen = float((*s)[0].number());
+            cam.shutterClose = float((*s)[1].number());
+            if (!(cam.shutterClose > cam.shutterOpen)) s->fail("expected close > open");
+        }
+        c.finish();
+    }
+
+    void parseMaterials(JsonNode mats) {
+        if (!mats.isObject()) mats.fail("expected an object mapping names to materials");
+        for (const std::string& name : mats.keys()) {
+            JsonNode m = mats[name];
+            Material mat;
+            mat.name = name;
+            mat.albedo = m["albedo"].color();
+            if (maxComponent(mat.albedo) > 1.f) m["albedo"].fail("albedo components must lie in [0, 1]");
+            if (auto e = m.optional("emission")) mat.emission = e->color();
+            if (auto t = m.optional("texture")) {
+                mat.texture = t->string();
+                if (mat.texture != "checker") t->fail("unknown texture '" + mat.texture + "' (expected \"checker\")");
+            }
+            if (auto ts = m.optional("texture_scale")) mat.textureScale = float(ts->positive());
+            m.finish();
+            m_materialIndex[name] = uint32_t(m_desc.materials.size());
+            m_desc.materials.push_back(mat);
+        }
+    }
+
+    void parseLights(JsonNode lights) {
+        for (size_t i = 0; i < lights.size(); ++i) {
+            JsonNode l = lights[i];
+            std::string type = l["type"].string();
+            if (type != "parallelogram") l["type"].fail("unknown light type '" + type + "' (expected \"parallelogram\")");
+            ParallelogramLight light;
+            light.corner = l["corner"].vec3();
+            light.edge1 = l["edge1"].vec3();
+            light.edge2 = l["edge2"].vec3();
+            light.radiance = l["radiance"].color();
+            if (light.area() <= 0) l["edge2"].fail("edge1 and edge2 span no area");
+            l.finish();
+            m_desc.lights.push_back(light);
+            // The light is visible to the camera as an emitter of its own (albedo 0).
+            Material mat;
+            mat.name = "light" + std::to_string(i);
+            mat.albedo = Vec3f(0.f);
+            mat.emission = light.radiance;
+            uint32_t id = uint32_t(m_desc.materials.size());
+            m_desc.materials.push_back(mat);
+            TriangleMesh mesh;
+            mesh.name = mat.name;
+            appendQuad(mesh, light.corner, light.edge1, light.edge2, id);
+            m_desc.meshes.push_back(std::move(mesh));
+        }
+    }
+
+    uint32_t material(JsonNode node) {
+        std::string name = node.string();
+        auto it = m_materialIndex.find(name);
+        if (it == m_materialIndex.end()) node.fail("unknown material '" + name + "'");
+        return it->second;
+    }
+
+    void parseObjects(JsonNode objects) {
+        if (objects.size() == 0) objects.fail("expected at least one object");
+        for (size_t i = 0; i < objects.size(); ++i) {
+            JsonNode o = objects[i];
+            std::string type = o["type"].string();
+            TriangleMesh mesh;
+            mesh.name = type + "[" + std::to_string(i) + "]";
+            if (auto v = o.optional("velocity")) mesh.velocity = v->vec3();
+            if (type == "mesh") {
+                parseMesh(o, mesh);
+            } else if (type == "quad") {
+                Vec3f corner = o["corner"].vec3(), e1 = o["edge1"].vec3(), e2 = o["edge2"].vec3();
+                if (length(cross(e1, e2)) <= 0) o["edge2"].fail("edge1 and edge2 span no area");
+                uint32_t mat = material(o["material"]);
+                appendQuad(mesh, corner, e1, e2, mat);
+                promoteIfEmissive(mat, corner, e1, e2, mesh.velocity);
+            } else if (type == "box") {
+                Vec3f lo = o["min"].vec3(), hi = o["max"].vec3();
+                if (!(hi.x > lo.x && hi.y > lo.y && hi.z > lo.z)) o["max"].fail("expected max > min in every axis");
+                appendBox(mesh, lo, hi, material(o["material"]));
+            } else if (type == "sphere") {
+                Sphere s;
+                s.center = o["center"].vec3();
+                s.radius = float(o["radius"].positive());
+                s.material = material(o["material"]);
+                s.velocity = mesh.velocity;
+                o.finish();
+                m_desc.spheres.push_back(s);
+                continue;
+            } else {
+                o["type"].fail("unknown object type '" + type + "' (expected mesh, quad, box or sphere)");
+            }
+            o.finish();
+            m_desc.meshes.push_back(std::move(mesh));
+        }
+    }
+
+    void parseMesh(JsonNode& o, TriangleMesh& mesh) {
+        JsonNode fileNode = o["file"];
+        std::string rel = fileNode.string();
+        fs::path p = fs::path(rel).is_absolute() ? fs::path(rel) : fs::path(m_baseDir) / rel;
+        int overrideMaterial = -1;
+        if (auto m = o.optional("material")) overrideMaterial = int(material(*m));
+        Transform xf;
+        if (auto s = o.optional("scale")) xf.scale = readScale(*s);
+        if (auto t = o.optional("translate")) xf.translate = t->vec3();
+        if (auto r = o.optional("rotate")) {
+            if (r->size() != 4) r->fail("expected [axis_x, axis_y, axis_z, degrees]");
+            Vec3f axis((*r)[0].number(), (*r)[1].number(), (*r)[2].number());
+            if (length(axis) <= 0) r->fail("rotation axis must be non-zero");
+            xf.axis = normalize(axis);
+            xf.radians = float((*r)[3].number()) * kDegToRad;
+        }
+        std::vector<ParallelogramLight> promoted;
+        loadObj(p.string(), fileNode.where(), overrideMaterial, m_desc.materials, mesh, promoted);
+        for (auto& v : mesh.positions) v = xf.apply(v);
+        for (auto& l : promoted) {
+            Vec3f c0 = xf.apply(l.corner);
+            l.edge1 = xf.apply(l.corner + l.edge1) - c0;
+            l.edge2 = xf.apply(l.corner + l.edge2) - c0;
+            l.corner = c0;
+            if (mesh.velocity == Vec3f(0.f)) m_desc.lights.push_back(l);
+        }
+    }
+
+    void promoteIfEmissive(uint32_t mat, const Vec3f& corner, const Vec3f& e1, const Vec3f& e2, const Vec3f& velocity) {
+        const Material& m = m_desc.materials[mat];
+        if (!m.isEmitter() || velocity != Vec3f(0.f)) return;  // moving emitters stay visible-only
+        m_desc.lights.push_back({corner, e1, e2, m.emission});
+    }
+
+    void parseRender(JsonNode r) {
+        if (auto s = r.optional("spp")) {
+            int spp = s->integer();
+            if (spp <= 0) s->fail("expected a positive number of samples");
+            m_desc.render.spp = spp;
+        }
+        if (auto s = r.optional("seed")) {
+            long long v = s->integer();
+            if (v < 0) s->fail("expected a non-negative seed");
+            m_desc.render.seed = uint32_t(v);
+        }
+        if (auto s = r.optional("indirect")) m_desc.render.indirect = s->boolean();
+        r.finish();
+    }
+
+    std::string m_file, m_baseDir;
+    SceneDesc m_desc;
+    std::map<std::string, uint32_t> m_materialIndex;
+};
+
+}  // namespace
+
+void loadObj(const std::string& path, const std::string& where, int overrideMaterial, std::vector<Material>& materials,
+             TriangleMesh& mesh, std::vector<ParallelogramLight>& promoted) {
+    if (!fs::is_regular_file(path)) throw Error(where, "mesh file '" + path + "' does not exist");
+    tinyobj::ObjReaderConfig config;
+    config.triangulate = false;  // keep quads, so that emissive parallelograms can become lights
+    config.vertex_color = false;
+    config.mtl_search_path = fs::path(path).parent_path().string();
+    tinyobj::ObjReader reader;
+    if (!reader.ParseFromFile(path, config))
+        throw Error(where, "cannot read OBJ '" + path + "': " + reader.Error());
+    const auto& attrib = reader.GetAttrib();
+    const auto& shapes = reader.GetShapes();
+    size_t faceCount = 0;
+    for (auto& s : shapes) faceCount += s.mesh.num_face_vertices.size();
+    if (attrib.vertices.empty() || faceCount == 0)
+        throw Error(where, "'" + path + "' contains no faces (is it a Wavefront OBJ file?)");
+
+    // Materials from the MTL, appended to the scene's list unless overridden.
+    std::vector<uint32_t> mtlToScene;
+    if (overrideMaterial < 0) {
+        std::string prefix = fs::path(path).filename().string() + ":";
+        for (const auto& m : reader.GetMaterials()) {
+            Material mat;
+            mat.name = prefix + m.name;
+            mat.albedo = Vec3f(m.diffuse[0], m.diffuse[1], m.diffuse[2]);
+            mat.albedo = vmin(vmax(mat.albedo, Vec3f(0.f)), Vec3f(1.f));
+            mat.emission = vmax(Vec3f(m.emission[0], m.emission[1], m.emission[2]), Vec3f(0.f));
+            mtlToScene.push_back(uint32_t(materials.size()));
+            materials.push_back(mat);
+        }
+    }
+
+    size_t vertexCount = attrib.vertices.size() / 3;
+    mesh.positions.reserve(mesh.positions.size() + vertexCount);
+    uint32_t base = uint32_t(mesh.positions.size());
+    for (size_t i = 0; i < vertexCount; ++i)
+        mesh.positions.emplace_back(attrib.vertices[3 * i], attrib.vertices[3 * i + 1], attrib.vertices[3 * i + 2]);
+    for (auto& v : mesh.positions)
+        if (!isFinite(v)) throw Error(where, "'" + path + "' has a non-finite vertex coordinate");
+
+    for (const auto& shape : shapes) {
+        size_t offset = 0;
+        for (size_t f = 0; f < shape.mesh.num_face_vertices.size(); ++f) {
+            int n = shape.mesh.num_face_vertices[f];
+            int mtl = shape.mesh.material_ids.empty() ? -1 : shape.mesh.material_ids[f];
+            uint32_t matId;
+            if (overrideMaterial >= 0) {
+                matId = uint32_t(overrideMaterial);
+            } else if (mtl >= 0 && size_t(mtl) < mtlToScene.size()) {
+                matId = mtlToScene[mtl];
+            } else {
+                throw Error(where, "'" + path + "': shape '" + shape.name +
+                                       "' has faces without a material (give the object a \"material\")");
+            }
+            std::vector<uint32_t> idx(n);
+            for (int k = 0; k < n; ++k) {
+                int vi = shape.mesh.indices[offset + k].vertex_index;
+                if (vi < 0 || size_t(vi) >= vertexCount)
+                    throw Error(where, "'" + path + "': face refers to a missing vertex");
+                idx[k] = base + uint32_t(vi);
+            }
+            offset += n;
+            if (n < 3) continue;
+            if (n == 4 && materials[matId].isEmitter()) {
+                Vec3f v[4];
+                for (int k = 0; k < 4; ++k) v[k] = mesh.positions[idx[k]];
+                ParallelogramLight light;
+                if (asParallelogram(v, light)) {
+                    light.radiance = materials[matId].emission;
+                    promoted.push_back(light);
+                }
+            }
+            for (int k = 1; k + 1 < n; ++k) {  // fan triangulation (OBJ faces are convex)
+                mesh.indices.insert(mesh.indices.end(), {idx[0], idx[k], idx[k + 1]});
+                mesh.materialIds.push_back(matId);
+            }
+        }
+    }
+    if (mesh.indices.empty()) throw Error(where, "'" + path + "' contains no triangles");
+}
+
+SceneDesc parseScene(const std::string& jsonText, const std::string& file, const std::string& baseDir) {
+    nlohmann::json doc;
+    try {
+        doc = nlohmann::json::parse(jsonText);
+    } catch (const nlohmann::json::parse_error& e) {
+        throw Error(file, std::string("invalid JSON: ") + e.what());
+    }
+    return SceneParser(file, baseDir).parse(doc);
+}
+
+std::string scenesDirectory() {
+    if (const char* env = std::getenv("WEDGE_SCENES"); env && *env) return env;
+    return WEDGE_SCENES_DIR;
+}
+
+std::vector<BuiltinScene> builtinScenes() {
+    fs::path index = fs::path(scenesDirectory()) / "index.json";
+    nlohmann::json doc = JsonNode::parseFile(index.string());
+    JsonNode root(doc, index.string(), "");
+    JsonNode list = root["scenes"];
+    std::vector<BuiltinScene> out;
+    for (size_t i = 0; i < list.size(); ++i) {
+        JsonNode s = list[i];
+        BuiltinScene b;
+        b.name = s["name"].string();
+        b.file = (fs::path(scenesDirectory()) / s["file"].string()).string();
+        b.description = s["description"].string();
+        if (auto a = s.optional("attribution")) b.attribution = a->string();
+        s.finish();
+        out.push_back(b);
+    }
+    root.finish();
+    return out;
+}
+
+SceneDesc loadScene(const std::string& pathOrName) {
+    std::string file = pathOrName;
+    if (!fs::exists(file) && file.find('/') == std::string::npos && fs::path(file).extension().empty()) {
+        bool found = false;
+        std::string names;
+        for (const auto& b : builtinScenes()) {
+            names += (names.empty() ? "" : ", ") + b.name;
+            if (b.name == pathOrName) { file = b.file; found = true; }
+        }
+        if (!found) throw Error(pathOrName, "no such scene file or built-in scene (built-ins: " + names + ")");
+    }
+    nlohmann::json doc = JsonNode::parseFile(file);
+    std::string baseDir = fs::path(file).parent_path().string();
+    if (baseDir.empty()) baseDir = ".";
+    return SceneParser(file, baseDir).parse(doc);
+}
+
+}  // namespace wedge::scene

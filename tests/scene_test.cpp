@@ -1,0 +1,78 @@
+// Scene module: geometry conventions of the built Embree scene and the occluder-span query.
+#include <gtest/gtest.h>
+
+#include "scene/scene.h"
+
+using namespace wedge;
+using namespace wedge::scene;
+
+namespace {
+
+SceneDesc oneQuad() {
+    SceneDesc d;
+    d.materials.push_back({"white", Vec3f(0.5f), Vec3f(0.f)});
+    TriangleMesh m;
+    appendQuad(m, {-1, -1, 0}, {2, 0, 0}, {0, 2, 0}, 0);  // normal +z
+    d.meshes.push_back(m);
+    d.lights.push_back({{-0.5f, -0.5f, 5}, {1, 0, 0}, {0, -1, 0}, Vec3f(1.f)});
+    return d;
+}
+
+}  // namespace
+
+TEST(Scene, TriangleNormalIsCounterClockwise) {
+    Scene s(oneQuad());
+    Hit h;
+    ASSERT_TRUE(s.intersect({0, 0, 3}, {0, 0, -1}, 0, kInf, 0, h));
+    EXPECT_NEAR(h.t, 3.f, 1e-5f);
+    EXPECT_NEAR(h.normal.z, 1.f, 1e-6f);
+    ASSERT_TRUE(s.intersect({0, 0, -3}, {0, 0, 1}, 0, kInf, 0, h));
+    EXPECT_NEAR(h.normal.z, 1.f, 1e-6f) << "the normal does not depend on the side the ray comes from";
+}
+
+TEST(Scene, LightNormalFollowsEdges) {
+    ParallelogramLight l{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, Vec3f(1.f)};
+    EXPECT_NEAR(l.normal().z, 1.f, 1e-6f);
+    EXPECT_NEAR(l.area(), 1.f, 1e-6f);
+}
+
+TEST(Scene, OccluderSpanFindsNearestAndFarthest) {
+    SceneDesc d = oneQuad();
+    TriangleMesh m;
+    appendQuad(m, {-1, -1, 1}, {2, 0, 0}, {0, 2, 0}, 0);
+    appendQuad(m, {-1, -1, 2.5f}, {2, 0, 0}, {0, 2, 0}, 0);
+    d.meshes.push_back(m);
+    Scene s(std::move(d));
+    OccluderSpan span = s.occluders({0, 0, 0.01f}, {0, 0, 1}, 0, 10, 0);
+    ASSERT_TRUE(span.occluded);
+    EXPECT_NEAR(span.tNear, 0.99f, 1e-4f);
+    EXPECT_NEAR(span.tFar, 2.49f, 1e-4f);
+    EXPECT_TRUE(s.occluded({0, 0, 0.01f}, {0, 0, 1}, 0, 10, 0));
+    EXPECT_FALSE(s.occluded({0, 0, 0.01f}, {0, 0, 1}, 0, 0.5f, 0));
+    EXPECT_FALSE(s.occluders({0, 0, 0.01f}, {0, 0, 1}, 0, 0.5f, 0).occluded);
+}
+
+TEST(Scene, SphereNormalPointsOutward) {
+    SceneDesc d = oneQuad();
+    d.spheres.push_back({{0, 0, 10}, 1.f, 0, Vec3f(0.f)});
+    Scene s(std::move(d));
+    Hit h;
+    ASSERT_TRUE(s.intersect({0, 0, 20}, {0, 0, -1}, 0, kInf, 0, h));
+    EXPECT_NEAR(h.t, 9.f, 1e-4f);
+    EXPECT_NEAR(h.normal.z, 1.f, 1e-4f);
+}
+
+TEST(Scene, MotionBlurMovesGeometryOverTheShutter) {
+    SceneDesc d;
+    d.materials.push_back({"white", Vec3f(0.5f), Vec3f(0.f)});
+    d.lights.push_back({{-0.5f, -0.5f, 5}, {1, 0, 0}, {0, -1, 0}, Vec3f(1.f)});
+    TriangleMesh m;
+    appendQuad(m, {-0.5f, -0.5f, 0}, {1, 0, 0}, {0, 1, 0}, 0);
+    m.velocity = {2, 0, 0};
+    d.meshes.push_back(m);
+    Scene s(std::move(d));
+    Hit h;
+    EXPECT_TRUE(s.intersect({0, 0, 1}, {0, 0, -1}, 0, kInf, 0.f, h));
+    EXPECT_FALSE(s.intersect({0, 0, 1}, {0, 0, -1}, 0, kInf, 0.5f, h));   // quad now spans x in [0.5, 1.5]
+    EXPECT_TRUE(s.intersect({1, 0, 1}, {0, 0, -1}, 0, kInf, 0.5f, h));
+}

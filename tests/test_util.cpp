@@ -1,0 +1,62 @@
+#include "test_util.h"
+
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <sys/wait.h>
+#include <unistd.h>
+
+namespace fs = std::filesystem;
+
+namespace wedge::test {
+
+namespace {
+struct TempRoot {
+    fs::path path;
+    TempRoot() {
+        path = fs::temp_directory_path() / ("wedge-test-" + std::to_string(getpid()));
+        fs::create_directories(path);
+    }
+    ~TempRoot() {
+        std::error_code ec;
+        fs::remove_all(path, ec);
+    }
+};
+TempRoot& root() {
+    static TempRoot r;
+    return r;
+}
+std::string slurp(const fs::path& p) {
+    std::ifstream in(p);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+}
+}  // namespace
+
+std::string tempDir() {
+    static int counter = 0;
+    fs::path p = root().path / ("d" + std::to_string(counter++));
+    fs::create_directories(p);
+    return p.string();
+}
+
+void writeFile(const std::string& path, const std::string& text) {
+    std::ofstream out(path);
+    out << text;
+}
+
+int runWedge(const std::string& args, std::string* out, std::string* err) {
+    std::string dir = tempDir();
+    std::string cmd = std::string(WEDGE_BIN) + " " + args + " >" + dir + "/out.txt 2>" + dir + "/err.txt";
+    int status = std::system(cmd.c_str());
+    if (out) *out = slurp(dir + "/out.txt");
+    if (err) *err = slurp(dir + "/err.txt");
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+std::string sourceDir() { return WEDGE_SOURCE_DIR; }
+
+}  // namespace wedge::test
