@@ -1,0 +1,168 @@
+// Command line: every malformed input ends with exit code 2, a message that names the file and
+// the field, and no output file.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+
+#include "test_util.h"
+
+using namespace wedge::test;
+namespace fs = std::filesystem;
+
+namespace {
+
+const char* kGood = R"({
+  "camera": {"position": [0, 1, 3], "look_at": [0, 0, 0], "up": [0, 1, 0], "fov_y": 40, "resolution": [8, 8]},
+  "materials": {"white": {"albedo": [0.8, 0.8, 0.8]}},
+  "lights": [{"type": "parallelogram", "corner": [-0.5, 2, -0.5], "edge1": [1, 0, 0], "edge2": [0, 0, 1], "radiance": [5, 5, 5]}],
+  "objects": [OBJECT],
+  "render": {"spp": 2, "seed": 1, "indirect": true}
+})";
+
+std::string scene(const std::string& object, const std::string& patchFrom = "", const std::string& patchTo = "") {
+    std::string s = kGood;
+    s.replace(s.find("OBJECT"), 6, object);
+    if (!patchFrom.empty()) {
+        auto p = s.find(patchFrom);
+        EXPECT_NE(p, std::string::npos) << patchFrom;
+        s.replace(p, patchFrom.size(), patchTo);
+    }
+    return s;
+}
+
+const std::string kSphere = R"({"type": "sphere", "center": [0, 0, 0], "radius": 0.5, "material": "white"})";
+
+struct Case {
+    const char* name;
+    std::string json;
+    const char* expect;  // substring of the message
+};
+
+/// Renders `json` (written as bad.json) and checks exit code 2, the message and no output.
+void expectRejected(const std::string& json, const std::string& expect, const std::string& extraArgs = "") {
+    std::string dir = tempDir();
+    writeFile(dir + "/bad.json", json);
+    std::string out = dir + "/out.png";
+    std::string err;
+    int code = runWedge("render " + dir + "/bad.json -o " + out + " --quiet " + extraArgs, nullptr, &err);
+    EXPECT_EQ(code, 2) << err;
+    EXPECT_NE(err.find(expect), std::string::npos) << "message was: " << err;
+    EXPECT_FALSE(fs::exists(out)) << "no output may be written on error";
+    for (auto& e : fs::directory_iterator(dir)) EXPECT_EQ(e.path().filename().string().find(".tmp"), std::string::npos);
+}
+
+}  // namespace
+
+TEST(Cli, GoodSceneRenders) {
+    std::string dir = tempDir();
+    writeFile(dir + "/good.json", scene(kSphere));
+    std::string err;
+    EXPECT_EQ(runWedge("render " + dir + "/good.json -o " + dir + "/a.png -o " + dir + "/a.exr -o " + dir +
+                           "/a.pfm --stats " + dir + "/s.json --quiet",
+                       nullptr, &err),
+              0)
+        << err;
+    for (const char* f : {"a.png", "a.exr", "a.pfm", "s.json"}) EXPECT_TRUE(fs::exists(dir + "/" + f)) << f;
+}
+
+TEST(Cli, UnknownKey) { expectRejected(scene(kSphere, "\"render\": {", "\"bogus\": 1, \"render\": {"), "bad.json: bogus: unknown key"); }
+
+TEST(Cli, UnknownNestedKey) {
+    expectRejected(scene(R"({"type": "sphere", "center": [0, 0, 0], "radius": 0.5, "material": "white", "color": 1})"),
+                   "bad.json: objects[0].color: unknown key");
+}
+
+TEST(Cli, WrongType) {
+    expectRejected(scene(R"({"type": "sphere", "center": [0, 0, 0], "radius": "big", "material": "white"})"),
+                   "bad.json: objects[0].radius: expected a positive number");
+}
+
+TEST(Cli, NegativeRadius) {
+    expectRejected(scene(R"({"type": "sphere", "center": [0, 0, 0], "radius": -1, "material": "white"})"),
+                   "objects[0].radius: expected a positive number");
+}
+
+TEST(Cli, MissingField) {
+    expectRejected(scene(R"({"type": "sphere", "radius": 1, "material": "white"})"), "objects[0].center: missing required field");
+}
+
+TEST(Cli, UnknownMaterial) {
+    expectRejected(scene(R"({"type": "sphere", "center": [0, 0, 0], "radius": 0.5, "material": "chrome"})"),
+                   "objects[0].material: unknown material 'chrome'");
+}
+
+TEST(Cli, NonPositiveResolution) {
+    expectRejected(scene(kSphere, "\"resolution\": [8, 8]", "\"resolution\": [0, 8]"),
+                   "camera.resolution[0]: expected a positive resolution");
+}
+
+TEST(Cli, BadVectorLength) {
+    expectRejected(scene(kSphere, "\"look_at\": [0, 0, 0]", "\"look_at\": [0, 0]"), "camera.look_at: expected an array of 3 numbers");
+}
+
+TEST(Cli, SyntaxErrorNamesLine) {
+    expectRejected(scene(kSphere, "\"render\": {", "\"render\": {,"), "bad.json:6:");
+}
+
+TEST(Cli, MissingSceneFile) {
+    std::string err;
+    EXPECT_EQ(runWedge("render /nonexistent/room.json --quiet", nullptr, &err), 2);
+    EXPECT_NE(err.find("/nonexistent/room.json"), std::string::npos) << err;
+}
+
+TEST(Cli, UnknownBuiltinScene) {
+    std::string err;
+    EXPECT_EQ(runWedge("render nosuchscene --quiet", nullptr, &err), 2);
+    EXPECT_NE(err.find("nosuchscene"), std::string::npos) << err;
+    EXPECT_NE(err.find("cornell"), std::string::npos) << "lists the built-ins: " << err;
+}
+
+TEST(Cli, MissingMeshFile) {
+    expectRejected(scene(R"({"type": "mesh", "file": "nothere.obj"})"), "objects[0].file: mesh file");
+}
+
+TEST(Cli, MeshThatIsNotAnObj) {
+    std::string dir = tempDir();
+    writeFile(dir + "/notobj.obj", "this is a PNG, honest\n\x89PNG\x01\x02\x03\n");
+    std::string json = scene(R"({"type": "mesh", "file": ")" + dir + R"(/notobj.obj"})");
+    expectRejected(json, "objects[0].file: '" + dir + "/notobj.obj' contains no faces");
+}
+
+TEST(Cli, ObjWithBadFaceIndex) {
+    std::string dir = tempDir();
+    writeFile(dir + "/broken.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 7\n");
+    expectRejected(scene(R"({"type": "mesh", "file": ")" + dir + R"(/broken.obj", "material": "white"})"),
+                   "face refers to a missing vertex");
+}
+
+TEST(Cli, NoLight) {
+    expectRejected(scene(kSphere, "\"lights\": [{\"type\": \"parallelogram\", \"corner\": [-0.5, 2, -0.5], \"edge1\": [1, 0, 0], \"edge2\": [0, 0, 1], \"radiance\": [5, 5, 5]}]",
+                         "\"lights\": []"),
+                   "lights: the scene has no light");
+}
+
+TEST(Cli, BadFlags) {
+    std::string dir = tempDir();
+    writeFile(dir + "/good.json", scene(kSphere));
+    std::string g = dir + "/good.json --quiet ";
+    std::string err;
+    EXPECT_EQ(runWedge("render " + g + "--spp -3", nullptr, &err), 2) << err;
+    EXPECT_EQ(runWedge("render " + g + "--spp abc", nullptr, &err), 2) << err;
+    EXPECT_EQ(runWedge("render " + g + "--method magic", nullptr, &err), 2) << err;
+    EXPECT_NE(err.find("--method"), std::string::npos) << err;
+    EXPECT_EQ(runWedge("render " + g + "--threads -1", nullptr, &err), 2) << err;
+    EXPECT_EQ(runWedge("render " + g + "--resolution 12by3", nullptr, &err), 2) << err;
+    EXPECT_NE(err.find("--resolution"), std::string::npos) << err;
+    EXPECT_EQ(runWedge("render " + g + "-o " + dir + "/x.jpg", nullptr, &err), 2) << err;
+    EXPECT_NE(err.find("x.jpg"), std::string::npos) << err;
+    EXPECT_FALSE(fs::exists(dir + "/x.jpg"));
+    EXPECT_EQ(runWedge("render " + g + "-o /nonexistent-dir/x.png", nullptr, &err), 2) << err;
+    EXPECT_EQ(runWedge("render", nullptr, &err), 2) << err;
+    EXPECT_EQ(runWedge("frobnicate", nullptr, &err), 2) << err;
+}
+
+TEST(Cli, ScenesListsBuiltins) {
+    std::string out;
+    EXPECT_EQ(runWedge("scenes", &out), 0);
+    for (const char* name : {"cornell", "grids", "conference", "sponza"}) EXPECT_NE(out.find(name), std::string::npos) << name;
+}

@@ -1,0 +1,193 @@
+// Render module: the path sampler against closed forms (direct light from a parallelogram,
+// one-bounce indirect in a sphere, the thin-lens circle of confusion) and determinism across
+// thread counts.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+
+#include "core/parallel.h"
+#include "render/camera.h"
+#include "render/renderer.h"
+#include "scene/scene.h"
+#include "scene/scene_loader.h"
+
+using namespace wedge;
+
+namespace {
+
+/// Lambert's formula: irradiance at x (normal n) from a uniform polygon of radiance 1, vertices in order.
+double polygonIrradiance(const Vec3f& x, const Vec3f& n, const std::vector<Vec3f>& poly) {
+    // In double precision: the edge angles of a small, distant polygon are tiny.
+    struct D3 {
+        double x, y, z;
+    };
+    auto sub = [](const Vec3f& p, const Vec3f& q) { return D3{double(p.x) - q.x, double(p.y) - q.y, double(p.z) - q.z}; };
+    auto dotd = [](const D3& a, const D3& b) { return a.x * b.x + a.y * b.y + a.z * b.z; };
+    auto crossd = [](const D3& a, const D3& b) { return D3{a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x}; };
+    D3 nd{n.x, n.y, n.z};
+    double sum = 0;
+    for (size_t i = 0; i < poly.size(); ++i) {
+        D3 a = sub(poly[i], x), b = sub(poly[(i + 1) % poly.size()], x);
+        D3 c = crossd(a, b);
+        double cl = std::sqrt(dotd(c, c));
+        double theta = std::atan2(cl, dotd(a, b));
+        sum += theta * dotd(nd, c) / cl;
+    }
+    return 0.5 * std::abs(sum);
+}
+
+scene::SceneDesc parse(const std::string& json) { return scene::parseScene(json, "test.json", "."); }
+
+render::RenderResult renderJson(const std::string& json, const render::RenderOptions& o) {
+    scene::Scene s(parse(json));
+    return render::render(s, o);
+}
+
+const char* kPlaneScene = R"({
+  "camera": {"position": [0, 0.8, 0.001], "look_at": [0, 0, 0], "up": [0, 0, -1], "fov_y": 90, "resolution": [24, 24]},
+  "materials": {"grey": {"albedo": [0.5, 0.6, 0.7]}},
+  "lights": [{"type": "parallelogram", "corner": [-0.3, 1, -0.5], "edge1": [1, 0, 0], "edge2": [0, 0, 1], "radiance": [10, 10, 10]}],
+  "objects": [{"type": "quad", "corner": [-4, 0, 4], "edge1": [8, 0, 0], "edge2": [0, 0, -8], "material": "grey"}],
+  "render": {"spp": 256, "seed": 3, "indirect": false}
+})";
+
+}  // namespace
+
+TEST(Render, LambertFormulaSanity) {
+    // A tiny light far above: E ~ L A / h^2.
+    std::vector<Vec3f> poly = {{-0.01f, 10, -0.01f}, {0.01f, 10, -0.01f}, {0.01f, 10, 0.01f}, {-0.01f, 10, 0.01f}};
+    EXPECT_NEAR(polygonIrradiance({0, 0, 0}, {0, 1, 0}, poly), 4e-4 / 100.0, 1e-8);
+}
+
+TEST(Render, PlaneUnderParallelogramMatchesClosedForm) {
+    render::RenderOptions o;
+    o.quiet = true;
+    render::RenderResult r = renderJson(kPlaneScene, o);
+    // Light corners (the light faces down: cross(edge1, edge2) = -y).
+    std::vector<Vec3f> poly = {{-0.3f, 1, -0.5f}, {0.7f, 1, -0.5f}, {0.7f, 1, 0.5f}, {-0.3f, 1, 0.5f}};
+    const Vec3f albedo(0.5f, 0.6f, 0.7f);
+    double sumRel = 0, maxRel = 0;
+    int n = 0;
+    for (int y = 0; y < r.color.height(); ++y)
+        for (int x = 0; x < r.color.width(); ++x) {
+            Vec3f p = r.buffers.position(x, y);
+            double e = 10.0 * polygonIrradiance(p, {0, 1, 0}, poly);
+            for (int c = 0; c < 3; ++c) {
+                double expected = albedo[c] * kInvPi * e;
+                double rel = std::abs(r.color(x, y)[c] - expected) / expected;
+                sumRel += rel;
+                maxRel = std::max(maxRel, rel);
+                ++n;
+            }
+            // The demodulated direct buffer is E / pi.
+            EXPECT_NEAR(r.buffers.direct(x, y).x, e * kInvPi, 0.08 * e * kInvPi);
+        }
+    EXPECT_LT(sumRel / n, 0.01) << "mean relative error over the image";
+    EXPECT_LT(maxRel, 0.08) << "worst pixel (256 stratified samples)";
+}
+
+TEST(Render, OneBounceInsideSphereMatchesFormFactorClosedForm) {
+    // Inside a sphere every pair of wall points has form factor dA / (4 pi R^2), so the first
+    // bounce of a light's whole flux Phi = pi L A gives the same irradiance everywhere:
+    // E = rho Phi / (4 pi R^2); the demodulated indirect buffer holds E / pi.
+    const double R = 2.0, L = 20.0, A = 0.2 * 0.2, rho = 0.8;
+    const char* json = R"({
+      "camera": {"position": [0, 0, 1.0], "look_at": [0, -1, -1], "up": [0, 1, 0], "fov_y": 60, "resolution": [16, 16]},
+      "materials": {"wall": {"albedo": [0.8, 0.8, 0.8]}},
+      "lights": [{"type": "parallelogram", "corner": [-0.1, 0.5, -0.1], "edge1": [0.2, 0, 0], "edge2": [0, 0, 0.2], "radiance": [20, 20, 20]}],
+      "objects": [{"type": "sphere", "center": [0, 0, 0], "radius": 2.0, "material": "wall"}],
+      "render": {"spp": 256, "seed": 5, "indirect": true}
+    })";
+    render::RenderOptions o;
+    o.quiet = true;
+    render::RenderResult r = renderJson(json, o);
+    double expected = rho * (kPi * L * A) / (4 * kPi * R * R) / kPi;
+    double mean = 0;
+    for (size_t i = 0; i < r.buffers.indirect.size(); ++i) mean += r.buffers.indirect[i].y;
+    mean /= double(r.buffers.indirect.size());
+    // Bounce rays that hit the (dark) light quad lose at most its solid angle, far below 1%.
+    EXPECT_NEAR(mean, expected, 0.02 * expected);
+}
+
+TEST(Render, ThinLensDiscMatchesCircleOfConfusion) {
+    // A small emissive sphere at depth z, focus at F: its image is a disc of diameter
+    // 2 A f_px |1/z - 1/F| pixels (thin lens), measured from the second moment of the image.
+    const char* json = R"({
+      "camera": {"position": [0, 0, 0], "look_at": [0, 0, -1], "up": [0, 1, 0], "fov_y": 40, "resolution": [64, 64],
+                 "aperture_radius": 0.3, "focus_distance": 2.0},
+      "materials": {"glow": {"albedo": [0, 0, 0], "emission": [1, 1, 1]}, "black": {"albedo": [0, 0, 0]}},
+      "lights": [{"type": "parallelogram", "corner": [100, 100, 100], "edge1": [1, 0, 0], "edge2": [0, 0, 1], "radiance": [1, 1, 1]}],
+      "objects": [{"type": "sphere", "center": [0, 0, -4], "radius": 0.02, "material": "glow"}],
+      "render": {"spp": 256, "seed": 7, "indirect": false}
+    })";
+    render::RenderOptions o;
+    o.quiet = true;
+    render::RenderResult r = renderJson(json, o);
+    render::Camera cam(parse(json).camera);
+    double coc = 2.0 * 0.3 * cam.focalPixels() * std::abs(1.0 / 4.0 - 1.0 / 2.0);
+    // The measured disc is the CoC convolved with the sphere's own image (radius rs) and the
+    // pixel box; second moments add: r_measured^2 = r_coc^2 + rs^2 + 2 * (1/12) * 2.
+    double rs = 0.02 * cam.focalPixels() / 4.0;
+    double w = 0, cx = 0, cy = 0;
+    for (int y = 0; y < 64; ++y)
+        for (int x = 0; x < 64; ++x) {
+            double v = r.color(x, y).x;
+            w += v;
+            cx += v * (x + 0.5);
+            cy += v * (y + 0.5);
+        }
+    ASSERT_GT(w, 0);
+    cx /= w;
+    cy /= w;
+    double m2 = 0;
+    for (int y = 0; y < 64; ++y)
+        for (int x = 0; x < 64; ++x) m2 += r.color(x, y).x * (sqr(x + 0.5 - cx) + sqr(y + 0.5 - cy));
+    // Uniform disc: E[rho^2] = r^2 / 2; remove the sphere image and the pixel box.
+    double diameter = 2.0 * std::sqrt(std::max(0.0, 2.0 * m2 / w - rs * rs - 1.0 / 3.0));
+    EXPECT_NEAR(cx, 32.0, 0.5);
+    EXPECT_NEAR(cy, 32.0, 0.5);
+    EXPECT_NEAR(diameter, coc, 0.04 * coc) << "CoC " << coc << " px";
+}
+
+TEST(Render, ThinLensRaysMeetOnTheFocalPlane) {
+    scene::CameraDesc d;
+    d.position = {1, 2, 3};
+    d.lookAt = {0, 0, 0};
+    d.apertureRadius = 0.3f;
+    d.focusDistance = 2.5f;
+    d.width = 100;
+    d.height = 80;
+    render::Camera cam(d);
+    render::Ray a = cam.generate(30.5f, 20.25f, {0, 0});
+    render::Ray b = cam.generate(30.5f, 20.25f, {0.7f, -0.5f});
+    Vec3f fwd = normalize(d.lookAt - d.position);
+    Vec3f pa = a.origin + a.direction * (2.5f / dot(a.direction, fwd));
+    Vec3f pb = b.origin + b.direction * ((2.5f - dot(b.origin - d.position, fwd)) / dot(b.direction, fwd));
+    EXPECT_LT(length(pa - pb), 1e-5f);
+    Vec2f px = cam.project(pa);
+    EXPECT_NEAR(px.x, 30.5f, 1e-3f);
+    EXPECT_NEAR(px.y, 20.25f, 1e-3f);
+}
+
+TEST(Render, ImageIsBitIdenticalOnOneAndTwoThreads) {
+    for (const char* method : {"mc"}) {
+        render::RenderOptions o;
+        o.quiet = true;
+        o.method = method;
+        o.spp = 8;
+        scene::Scene s(parse(kPlaneScene));
+        render::RenderResult r1, r2;
+        {
+            ThreadLimit one(1);
+            r1 = render::render(s, o);
+        }
+        {
+            ThreadLimit two(2);
+            r2 = render::render(s, o);
+        }
+        ASSERT_EQ(r1.color.size(), r2.color.size());
+        EXPECT_EQ(0, std::memcmp(r1.color.data(), r2.color.data(), r1.color.size() * sizeof(Vec3f))) << method;
+        EXPECT_EQ(0, std::memcmp(r1.buffers.direct.data(), r2.buffers.direct.data(), r1.color.size() * sizeof(Vec3f)));
+    }
+}
