@@ -1,0 +1,49 @@
+// Image error metrics for comparing a rendering against a reference, as the filtering papers
+// report them (definitions in shared/papers/NOTES.md, "Error metrics"):
+//   relMSE = mean over pixels and channels of (x - r)^2 / (r^2 + eps), eps = 0.01, on linear
+//            radiance, WITHOUT the factor 0.5 some papers add;
+//   SMAPE  = mean over pixels and channels of |x - r| / (|x| + |r| + eps), eps = 0.01, linear;
+//   PSNR   = 10 log10(1 / MSE) on tone-mapped images in [0, 1] (infinite for identical images);
+//   SSIM   = Wang et al. 2004 with an 11x11 Gaussian window (sigma 1.5), C1 = (0.01 L)^2,
+//            C2 = (0.03 L)^2, L = 1, on tone-mapped images, averaged over pixels and channels.
+// Tone mapping is the one PNG output uses: clamp to [0, 1], then the sRGB transfer curve. Near
+// the border the SSIM window is cut to the image and renormalised, so every pixel (and images
+// smaller than the window) gets a value.
+#pragma once
+
+#include "core/image.h"
+
+namespace wedge::metrics {
+
+constexpr float kRelMseEpsilon = 0.01f;
+constexpr float kSmapeEpsilon = 0.01f;
+
+/// Linear radiance -> display value in [0, 1] (clamp, sRGB curve).
+float toneMap(float linear);
+Image3f toneMapped(const Image3f& linear);
+
+/// All metrics require equal sizes (a programmer error otherwise: compare() validates input).
+double relMse(const Image3f& test, const Image3f& reference, float eps = kRelMseEpsilon);
+double smape(const Image3f& test, const Image3f& reference, float eps = kSmapeEpsilon);
+/// Mean squared error of already tone-mapped images.
+double mseDisplay(const Image3f& testDisplay, const Image3f& referenceDisplay);
+/// PSNR in dB of the tone-mapped images; +infinity when they are identical.
+double psnr(const Image3f& test, const Image3f& reference);
+/// Mean SSIM of the tone-mapped images.
+double ssim(const Image3f& test, const Image3f& reference);
+/// SSIM of two single-channel images with values in [0, 1], per pixel.
+Image1f ssimMap(const Image1f& x, const Image1f& y);
+
+/// Per-pixel relative squared error (x - r)^2 / (r^2 + eps), averaged over the channels; its
+/// mean is relMse().
+Image1f relativeErrorMap(const Image3f& test, const Image3f& reference, float eps = kRelMseEpsilon);
+/// log10 of an error map, floored at 10^lo (for heat maps over [lo, hi] decades).
+Image1f log10Map(const Image1f& values, float lo);
+
+struct Metrics {
+    double relMse = 0, smape = 0, psnr = 0, ssim = 0;
+};
+/// Every metric at once; throws wedge::Error when the sizes differ.
+Metrics compare(const Image3f& test, const Image3f& reference);
+
+}  // namespace wedge::metrics

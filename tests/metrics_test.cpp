@@ -1,0 +1,168 @@
+// Metrics module: relMSE, SMAPE, PSNR and SSIM on synthetic images with known answers, and the
+// `wedge compare` command over image files.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "core/error.h"
+#include "io/image_io.h"
+#include "metrics/metrics.h"
+#include "test_util.h"
+
+using namespace wedge;
+using namespace wedge::metrics;
+
+namespace {
+
+Image3f constant(int w, int h, float v) { return Image3f(w, h, Vec3f(v)); }
+
+/// A deterministic pattern with structure at several scales, values in [0, 1].
+Image3f pattern(int w, int h) {
+    Image3f img(w, h);
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+            float v = 0.5f + 0.25f * std::sin(0.7f * x) * std::cos(0.4f * y) + ((x / 4 + y / 4) % 2 ? 0.2f : -0.2f);
+            img(x, y) = {v, 0.5f * v, 1.f - v};
+        }
+    return img;
+}
+
+}  // namespace
+
+TEST(Metrics, IdenticalImagesHaveZeroErrorAndPerfectSimilarity) {
+    Image3f a = pattern(24, 20);
+    Metrics m = compare(a, a);
+    EXPECT_EQ(m.relMse, 0.0);
+    EXPECT_EQ(m.smape, 0.0);
+    EXPECT_TRUE(std::isinf(m.psnr) && m.psnr > 0);
+    EXPECT_NEAR(m.ssim, 1.0, 1e-9);
+}
+
+TEST(Metrics, RelMseOfAConstantOffset) {
+    // (1.1 - 1)^2 / (1 + 0.01), no 0.5 factor.
+    EXPECT_NEAR(relMse(constant(8, 8, 1.1f), constant(8, 8, 1.f)), 0.01 / 1.01, 1e-6);
+    // Against black the epsilon is the whole denominator: 0.5^2 / 0.01 = 25.
+    EXPECT_NEAR(relMse(constant(8, 8, 0.5f), constant(8, 8, 0.f)), 25.0, 1e-4);
+    // Half the pixels wrong by 100% of a bright reference: mean of 1 * 100/100.01 and 0.
+    Image3f ref = constant(4, 2, 10.f), test = ref;
+    for (int x = 0; x < 4; ++x) test(x, 0) = Vec3f(20.f);
+    EXPECT_NEAR(relMse(test, ref), 0.5 * 100.0 / 100.01, 1e-6);
+    // The mean of the per-pixel map is the metric.
+    Image1f map = relativeErrorMap(test, ref);
+    double mean = 0;
+    for (size_t i = 0; i < map.size(); ++i) mean += map[i];
+    EXPECT_NEAR(mean / map.size(), relMse(test, ref), 1e-7);
+}
+
+TEST(Metrics, SmapeOfKnownPairs) {
+    EXPECT_NEAR(smape(constant(4, 4, 1.f), constant(4, 4, 0.f)), 1.0 / 1.01, 1e-6);
+    EXPECT_NEAR(smape(constant(4, 4, 3.f), constant(4, 4, 1.f)), 2.0 / 4.01, 1e-6);
+    // Symmetric in its arguments.
+    Image3f a = pattern(9, 7), b = constant(9, 7, 0.3f);
+    EXPECT_NEAR(smape(a, b), smape(b, a), 1e-12);
+}
+
+TEST(Metrics, PsnrOnToneMappedValues) {
+    // Display values 0.1 apart everywhere: MSE 0.01, PSNR 20 dB.
+    Image3f test = constant(8, 8, io::srgbDecode(0.6f)), ref = constant(8, 8, io::srgbDecode(0.5f));
+    EXPECT_NEAR(psnr(test, ref), 20.0, 1e-3);
+    // Values above 1 are clamped by the tone map: 2 and 5 look the same.
+    EXPECT_TRUE(std::isinf(psnr(constant(4, 4, 2.f), constant(4, 4, 5.f))));
+    // White against black: MSE 1, PSNR 0 dB.
+    EXPECT_NEAR(psnr(constant(4, 4, 1.f), constant(4, 4, 0.f)), 0.0, 1e-5);
+}
+
+TEST(Metrics, ToneMapMatchesThePngWriter) {
+    for (float v : {0.f, 0.001f, 0.0031308f, 0.02f, 0.18f, 0.5f, 1.f, 3.f})
+        EXPECT_NEAR(toneMap(v), io::srgbEncode(v), 1e-6f) << v;
+    EXPECT_EQ(toneMap(-1.f), 0.f);
+    EXPECT_EQ(toneMap(std::nanf("")), 0.f);
+}
+
+TEST(Metrics, SsimOfConstantImagesIsTheLuminanceTerm) {
+    // No variance: SSIM = (2 a b + C1) / (a^2 + b^2 + C1), C1 = 0.0001.
+    const float a = 0.5f, b = 0.25f;
+    double expected = (2.0 * a * b + 1e-4) / (a * a + b * b + 1e-4);
+    Image3f x = constant(16, 16, io::srgbDecode(a)), y = constant(16, 16, io::srgbDecode(b));
+    EXPECT_NEAR(ssim(x, y), expected, 1e-5);
+    // Smaller than the 11x11 window still works (the window is cut to the image).
+    EXPECT_NEAR(ssim(constant(3, 2, io::srgbDecode(a)), constant(3, 2, io::srgbDecode(b))), expected, 1e-5);
+}
+
+TEST(Metrics, SsimOfAnInvertedPatternIsNegative) {
+    // y = 1 - x has the same local variance but covariance -var: the structure term is
+    // (C2 - 2 var) / (2 var + C2), so SSIM < 0 wherever the pattern has contrast.
+    Image1f x(20, 20), y(20, 20);
+    for (int j = 0; j < 20; ++j)
+        for (int i = 0; i < 20; ++i) {
+            x(i, j) = (i + j) % 2 ? 0.8f : 0.2f;
+            y(i, j) = 1.f - x(i, j);
+        }
+    Image1f m = ssimMap(x, y);
+    for (size_t i = 0; i < m.size(); ++i) EXPECT_LT(m[i], -0.9f);
+    Image1f same = ssimMap(x, x);
+    for (size_t i = 0; i < same.size(); ++i) EXPECT_NEAR(same[i], 1.f, 1e-5f);
+}
+
+TEST(Metrics, SsimDropsMonotonicallyWithNoise) {
+    Image3f ref = pattern(32, 32);
+    double previous = 1.0;
+    for (float amplitude : {0.02f, 0.05f, 0.1f, 0.2f}) {
+        Image3f noisy = ref;
+        uint32_t state = 12345;
+        for (size_t i = 0; i < noisy.size(); ++i)
+            for (int c = 0; c < 3; ++c) {
+                state = state * 1664525u + 1013904223u;
+                noisy[i][c] = std::max(0.f, noisy[i][c] + amplitude * (float(state >> 8) / float(1 << 24) - 0.5f));
+            }
+        double s = ssim(noisy, ref);
+        EXPECT_LT(s, previous) << amplitude;
+        EXPECT_GT(s, 0.0);
+        previous = s;
+    }
+}
+
+TEST(Metrics, CompareRejectsSizeMismatch) {
+    EXPECT_THROW(compare(constant(4, 4, 1.f), constant(4, 5, 1.f)), Error);
+}
+
+TEST(Metrics, Log10MapFloorsAtTheLowEnd) {
+    Image1f v(3, 1);
+    v[0] = 0.f;
+    v[1] = 1e-2f;
+    v[2] = 10.f;
+    Image1f l = log10Map(v, -4.f);
+    EXPECT_NEAR(l[0], -4.f, 1e-6f);
+    EXPECT_NEAR(l[1], -2.f, 1e-6f);
+    EXPECT_NEAR(l[2], 1.f, 1e-6f);
+}
+
+TEST(CompareCommand, PrintsJsonAndWritesAHeatMap) {
+    std::string dir = test::tempDir();
+    io::writePfm(dir + "/ref.pfm", constant(6, 5, 1.f));
+    io::writePfm(dir + "/test.pfm", constant(6, 5, 1.1f));
+    std::string out, err;
+    ASSERT_EQ(test::runWedge("compare " + dir + "/test.pfm " + dir + "/ref.pfm --json --heatmap " + dir + "/heat.png",
+                             &out, &err),
+              0)
+        << err;
+    auto j = nlohmann::json::parse(out);
+    EXPECT_NEAR(j["relmse"].get<double>(), 0.01 / 1.01, 1e-5);
+    EXPECT_NEAR(j["smape"].get<double>(), 0.1 / 2.11, 1e-5);
+    Image3f heat = io::readPng(dir + "/heat.png");
+    EXPECT_EQ(heat.width(), 6);
+    EXPECT_EQ(heat.height(), 5);
+}
+
+TEST(CompareCommand, BadInputExitsWithTwo) {
+    std::string dir = test::tempDir();
+    io::writePfm(dir + "/a.pfm", constant(4, 4, 1.f));
+    io::writePfm(dir + "/b.pfm", constant(5, 4, 1.f));
+    std::string err;
+    EXPECT_EQ(test::runWedge("compare " + dir + "/a.pfm " + dir + "/b.pfm", nullptr, &err), 2);
+    EXPECT_NE(err.find("size mismatch"), std::string::npos) << err;
+    EXPECT_EQ(test::runWedge("compare " + dir + "/a.pfm " + dir + "/missing.pfm", nullptr, &err), 2);
+    EXPECT_EQ(test::runWedge("compare " + dir + "/a.pfm " + dir + "/a.pfm --heatmap " + dir + "/h.jpg", nullptr, &err), 2);
+}
