@@ -7,11 +7,12 @@ packages=(
   build-essential cmake pkg-config
   libembree-dev libtbb-dev libopenexr-dev libpng-dev libtinyobjloader-dev
   nlohmann-json3-dev libcli11-dev libfftw3-dev libgtest-dev libbenchmark-dev
+  chromium
 )
-# Optional extras: `WEDGE_EXTRAS=1` adds the browser used by the report test and Embree's
-# path tracer used as the throughput peer in bench/.
+# chromium: the headless browser the experiment-report test screenshots (tests/experiment_test.cpp).
+# Optional extras: `WEDGE_EXTRAS=1` adds Embree's path tracer used as the throughput peer in bench/.
 if [[ "${WEDGE_EXTRAS:-0}" == 1 ]]; then
-  packages+=(chromium embree-tools)
+  packages+=(embree-tools)
 fi
 
 missing=()

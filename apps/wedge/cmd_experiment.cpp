@@ -1,7 +1,109 @@
+// wedge experiment SCENE --methods mc,aaf,maaf,atrous --spp N --reference-spp M --out DIR
+//                  [--equal-time] [--equal-quality] [--resolution WxH] [--quiet] ...
+// Flags -> ExperimentOptions -> render::runExperiment (src/render/experiment.h), which writes
+// DIR/results.json, DIR/index.html, DIR/table.md and DIR/images/.
+#include <fstream>
+#include <iterator>
+#include <memory>
+
 #include "apps/wedge/commands.h"
+#include "apps/wedge/common.h"
+#include "core/error.h"
+#include "core/parallel.h"
+#include "render/experiment.h"
+#include "scene/scene.h"
+#include "scene/scene_loader.h"
 
 namespace wedge::app {
 
-void registerExperiment(CLI::App&) {}
+namespace {
+
+struct ExperimentArgs {
+    render::ExperimentOptions options;
+    std::string resolution;
+    int threads = 0;
+    long long seed = -1;
+};
+
+std::string shellQuote(const std::string& s) {
+    if (!s.empty() && s.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789-_./,=:") ==
+                          std::string::npos)
+        return s;
+    std::string out = "'";
+    for (char c : s) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
+    return out + "'";
+}
+
+/// This process's command line (Linux /proc), argv[0] shown as "wedge"; empty if unreadable.
+std::string commandLine() {
+    std::ifstream in("/proc/self/cmdline", std::ios::binary);
+    std::string all((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    std::string line;
+    size_t start = 0;
+    for (int i = 0; start < all.size(); ++i) {
+        size_t end = all.find('\0', start);
+        if (end == std::string::npos) end = all.size();
+        line += i == 0 ? std::string("wedge") : " " + shellQuote(all.substr(start, end - start));
+        start = end + 1;
+    }
+    return line;
+}
+
+void runExperiment(ExperimentArgs& a) {
+    render::ExperimentOptions& o = a.options;
+    if (o.methods.empty()) o.methods = render::methods();
+    if (a.seed >= 0) o.seed = uint32_t(a.seed);
+    render::checkExperimentOptions(o);
+
+    ThreadLimit limit(a.threads);
+    scene::SceneDesc desc = scene::loadScene(o.sceneName);
+    applyResolution(desc, a.resolution);
+    scene::Scene scene(std::move(desc));
+    render::runExperiment(scene, o);
+}
+
+}  // namespace
+
+void registerExperiment(CLI::App& app) {
+    auto args = std::make_shared<ExperimentArgs>();
+    CLI::App* cmd = app.add_subcommand(
+        "experiment", "Render a scene with several methods against a reference; equal-time and equal-quality report");
+    cmd->add_option("scene", args->options.sceneName, "Scene file (JSON) or built-in name (see 'wedge scenes')")
+        ->required();
+    cmd->add_option("--methods", args->options.methods, "Comma-separated methods (default: all; unavailable ones are skipped)")
+        ->delimiter(',');
+    cmd->add_option("--spp", args->options.spp, "Base samples per pixel of every method (initial spp for aaf/maaf)")
+        ->check(CLI::PositiveNumber);
+    cmd->add_option("--reference-spp", args->options.referenceSpp, "Samples per pixel of the MC reference")
+        ->check(CLI::PositiveNumber);
+    cmd->add_option("--out", args->options.outDir, "Output directory (created if missing)")->required();
+    cmd->add_option("--cache", args->options.cacheDir, "Directory of cached references (default: OUT/cache)");
+    cmd->add_flag("--equal-time", args->options.equalTime, "Find each method's spp at the anchor's total time");
+    cmd->add_flag("--equal-quality", args->options.equalQuality, "Find each method's spp at the anchor's relMSE");
+    cmd->add_option("--anchor", args->options.anchor,
+                    "Method the others are matched to (default: maaf, else aaf, else atrous, else the first)");
+    cmd->add_option("--max-spp", args->options.maxSpp, "Upper bound of the searches (default: reference spp / 4)")
+        ->check(CLI::NonNegativeNumber);
+    cmd->add_option("--tolerance", args->options.tolerance, "Relative spp resolution of the searches")
+        ->check(CLI::Range(0.0, 10.0));
+    cmd->add_option("--resolution", args->resolution, "Override the camera resolution, WxH");
+    cmd->add_option("--seed", args->seed, "Random seed of the methods (default: the scene's render.seed)")
+        ->check(CLI::NonNegativeNumber);
+    cmd->add_option("--threads", args->threads, "Worker threads (0: all cores)")->check(CLI::NonNegativeNumber);
+    render::RenderOptions& r = args->options.base;
+    cmd->add_option("--max-extra-spp", r.maxExtraSpp, "aaf/maaf: cap on adaptive samples per pixel")
+        ->check(CLI::NonNegativeNumber);
+    cmd->add_option("--atrous-iterations", r.atrousIterations, "atrous: wavelet levels")->check(CLI::Range(1, 10));
+    cmd->add_option("--sigma-color", r.atrousSigmaColor, "atrous: colour edge-stopping sigma")->check(CLI::PositiveNumber);
+    cmd->add_option("--sigma-normal", r.atrousSigmaNormal, "atrous: normal edge-stopping sigma")->check(CLI::PositiveNumber);
+    cmd->add_option("--sigma-position", r.atrousSigmaPosition, "atrous: position edge-stopping sigma (pixel footprints)")
+        ->check(CLI::PositiveNumber);
+    cmd->add_flag("!--no-variance", r.atrousVarianceGuided, "atrous: plain colour edge-stopping instead of variance-guided");
+    cmd->add_flag("-q,--quiet", args->options.quiet, "No progress on stderr and no table on stdout");
+    cmd->callback([args] {
+        args->options.commandLine = commandLine();
+        runExperiment(*args);
+    });
+}
 
 }  // namespace wedge::app

@@ -1,0 +1,203 @@
+// `wedge experiment`: the boundary search behind equal quality and equal time, the files a tiny
+// experiment writes (results.json rows, a self-contained index.html, the cached reference), bad
+// input, and the report as headless Chromium shows it (a screenshot that must not be blank).
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <regex>
+#include <set>
+#include <sstream>
+
+#include "io/image_io.h"
+#include "render/experiment.h"
+#include "test_util.h"
+
+using namespace wedge;
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string slurp(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+}
+
+/// A small experiment in a fresh directory; returns the directory.
+std::string runTinyExperiment(const std::string& extra = "", std::string* err = nullptr) {
+    std::string dir = test::tempDir() + "/exp";
+    std::string e;
+    int rc = test::runWedge("experiment cornell --methods mc,atrous --spp 2 --reference-spp 16 --resolution 24x24 "
+                            "--threads 1 --equal-quality --equal-time --out " + dir + " " + extra,
+                            nullptr, &e);
+    EXPECT_EQ(rc, 0) << e;
+    if (err) *err = e;
+    return dir;
+}
+
+}  // namespace
+
+TEST(ExperimentSearch, FindsTheBoundaryFromBelowAndAbove) {
+    for (int boundary : {1, 2, 5, 37, 100, 256}) {
+        for (int start : {1, 4, 16, 300}) {
+            if (start > 256) continue;
+            int evaluations = 0;
+            auto above = [&](int s) {
+                EXPECT_GE(s, 1);
+                EXPECT_LE(s, 256);
+                ++evaluations;
+                return s >= boundary;
+            };
+            render::SearchBracket b = render::searchBoundary(above, start, start >= boundary, 30.0, 256, 0.0);
+            EXPECT_EQ(b.hi, boundary) << "start " << start;
+            EXPECT_EQ(b.lo, boundary - 1) << "start " << start;
+            EXPECT_LE(evaluations, 12) << "boundary " << boundary << " start " << start;
+        }
+    }
+}
+
+TEST(ExperimentSearch, ReportsATargetOutOfReach) {
+    auto never = [](int) { return false; };
+    render::SearchBracket b = render::searchBoundary(never, 4, false, 1000.0, 64, 0.1);
+    EXPECT_EQ(b.hi, 65);
+    EXPECT_EQ(b.lo, 64);
+}
+
+TEST(ExperimentSearch, ToleranceStopsEarly) {
+    int evaluations = 0;
+    auto above = [&](int s) {
+        ++evaluations;
+        return s >= 700;
+    };
+    render::SearchBracket b = render::searchBoundary(above, 16, false, 100.0, 4096, 0.25);
+    EXPECT_GE(b.hi, 700);
+    EXPECT_LT(b.lo, 700);
+    EXPECT_LE(double(b.hi), double(b.lo) * 1.25 + 1);
+    EXPECT_LE(evaluations, 8);
+}
+
+TEST(ExperimentCommand, WritesRowsAndASelfContainedReport) {
+    std::string dir = runTinyExperiment("--quiet");
+    auto rows = nlohmann::json::parse(slurp(dir + "/results.json"));
+    ASSERT_TRUE(rows.is_array());
+    std::set<std::string> seen;
+    for (const auto& r : rows) {
+        for (const char* key : {"method", "spp", "spp_average", "seconds", "relmse", "psnr", "ssim"})
+            EXPECT_TRUE(r.contains(key)) << key << " missing in " << r.dump();
+        EXPECT_TRUE(r["seconds"].contains("total"));
+        EXPECT_TRUE(r["seconds"].contains("sampling"));
+        std::string setting = r["setting"];
+        seen.insert(r["method"].get<std::string>() + "/" + setting);
+        if (setting == "equal_quality" && r["reached"].get<bool>())
+            EXPECT_LE(r["relmse"].get<double>(), r["target_relmse"].get<double>());
+        if (setting == "equal_time" && r["reached"].get<bool>())
+            EXPECT_LE(r["seconds"]["total"].get<double>(), r["target_seconds"].get<double>());
+        EXPECT_TRUE(fs::is_regular_file(dir + "/" + r["image"].get<std::string>()));
+    }
+    // atrous is the anchor here (no aaf/maaf requested): mc gets searched, atrous does not.
+    EXPECT_TRUE(seen.count("mc/base") && seen.count("atrous/base"));
+    EXPECT_TRUE(seen.count("mc/equal_quality") && seen.count("mc/equal_time"));
+    EXPECT_FALSE(seen.count("atrous/equal_quality"));
+    for (const auto& r : rows) {
+        if (r["method"] == "atrous") EXPECT_GT(r["seconds"]["filter"].get<double>(), 0.0);
+        EXPECT_EQ(r["anchor"], "atrous");
+    }
+
+    std::string html = slurp(dir + "/index.html");
+    // Self-contained: every image is inline and nothing is loaded from elsewhere.
+    std::regex src("src=\"([^\"]*)\"");
+    int images = 0;
+    for (auto it = std::sregex_iterator(html.begin(), html.end(), src); it != std::sregex_iterator(); ++it) {
+        EXPECT_EQ((*it)[1].str().rfind("data:image/png;base64,", 0), 0u) << (*it)[1].str().substr(0, 60);
+        ++images;
+    }
+    // Reference + 4 rows, each with 2 insets, and a heat map per row.
+    EXPECT_EQ(images, 5 * 3 + 4);
+    EXPECT_NE(html.find("Fig. 12"), std::string::npos);
+    EXPECT_NE(html.find("speedup"), std::string::npos);
+    EXPECT_TRUE(fs::is_regular_file(dir + "/table.md"));
+}
+
+TEST(ExperimentCommand, CachesTheReferenceAndShowsProgressUnlessQuiet) {
+    std::string dir = test::tempDir() + "/exp";
+    std::string args = "experiment cornell --methods mc,atrous --spp 2 --reference-spp 16 --out " + dir + " --resolution ";
+    std::string args16 = args + "16x16";
+    std::string out, err;
+    ASSERT_EQ(test::runWedge(args16, &out, &err), 0) << err;
+    EXPECT_NE(err.find("rendering the reference"), std::string::npos) << err;
+    EXPECT_NE(err.find("100%"), std::string::npos) << "a progress bar on stderr";
+    EXPECT_NE(out.find("| atrous |"), std::string::npos) << out;
+    int cached = 0;
+    for (const auto& e : fs::directory_iterator(dir + "/cache")) cached += e.path().extension() == ".exr";
+    EXPECT_EQ(cached, 1);
+    ASSERT_EQ(test::runWedge(args16, &out, &err), 0) << err;
+    EXPECT_NE(err.find("reference from cache"), std::string::npos) << err;
+    // Quiet: nothing on stdout or stderr.
+    ASSERT_EQ(test::runWedge(args16 + " --quiet", &out, &err), 0) << err;
+    EXPECT_EQ(out, "");
+    EXPECT_EQ(err, "");
+    // A different resolution is a different reference.
+    ASSERT_EQ(test::runWedge(args + "12x12 --quiet", &out, &err), 0) << err;
+    cached = 0;
+    for (const auto& e : fs::directory_iterator(dir + "/cache")) cached += e.path().extension() == ".exr";
+    EXPECT_EQ(cached, 2);
+}
+
+TEST(ExperimentCommand, BadInputExitsWithTwo) {
+    std::string dir = test::tempDir();
+    test::writeFile(dir + "/file", "x");
+    const std::string base = "experiment cornell --resolution 8x8 --spp 2 --reference-spp 8 --quiet ";
+    std::string err;
+    EXPECT_EQ(test::runWedge(base + "--methods mc,bogus --out " + dir + "/a", nullptr, &err), 2);
+    EXPECT_NE(err.find("bogus"), std::string::npos) << err;
+    EXPECT_EQ(test::runWedge(base + "--methods mc,mc --out " + dir + "/a", nullptr, &err), 2);
+    EXPECT_EQ(test::runWedge(base + "--methods mc --anchor atrous --out " + dir + "/a", nullptr, &err), 2);
+    EXPECT_EQ(test::runWedge(base + "--methods mc --out " + dir + "/file", nullptr, &err), 2);
+    EXPECT_EQ(test::runWedge(base + "--methods mc --out " + dir + "/missing/parent", nullptr, &err), 2);
+    EXPECT_EQ(test::runWedge(base + "--methods mc --reference-spp 2 --out " + dir + "/a", nullptr, &err), 2);
+    EXPECT_EQ(test::runWedge(base + "--methods mc --resolution 8by8 --out " + dir + "/a", nullptr, &err), 2);
+    EXPECT_EQ(test::runWedge("experiment no-such-scene --quiet --out " + dir + "/a", nullptr, &err), 2);
+    EXPECT_EQ(test::runWedge("experiment cornell --quiet", nullptr, &err), 2) << "--out is required";
+    EXPECT_FALSE(fs::exists(dir + "/a")) << "nothing is written for bad input";
+}
+
+// The report as people see it: headless Chromium renders index.html, and the screenshot must
+// show the images (many distinct colours, a good share of non-white pixels). Chromium is a
+// build dependency (scripts/install-deps.sh); without it this test fails rather than skips.
+TEST(ExperimentReport, OpensInHeadlessChromiumAndShowsItsImages) {
+    std::string browser;
+    for (const char* name : {"chromium", "chromium-browser"})
+        if (std::system((std::string("command -v ") + name + " >/dev/null 2>&1").c_str()) == 0) browser = name;
+    ASSERT_FALSE(browser.empty()) << "chromium not found: run scripts/install-deps.sh (Debian package 'chromium')";
+
+    std::string dir = runTinyExperiment("--quiet");
+    std::string profile = test::tempDir(), shot = test::tempDir() + "/shot.png";
+    std::string cmd = "timeout 60 " + browser +
+                      " --headless --no-sandbox --disable-gpu --disable-quic --no-first-run"
+                      " --disable-background-networking --disable-component-update --disable-sync"
+                      " --user-data-dir=" + profile + " --screenshot=" + shot +
+                      " --window-size=1200,1400 file://" + fs::absolute(dir + "/index.html").string() + " >/dev/null 2>&1";
+    ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd;
+    ASSERT_TRUE(fs::is_regular_file(shot));
+    Image3f img = io::readPng(shot);
+    ASSERT_EQ(img.width(), 1200);
+    std::set<uint32_t> colours;
+    size_t nonWhite = 0;
+    for (size_t i = 0; i < img.size(); ++i) {
+        uint32_t r = uint32_t(io::srgbEncode(img[i].x) * 255.f + 0.5f), g = uint32_t(io::srgbEncode(img[i].y) * 255.f + 0.5f),
+                 b = uint32_t(io::srgbEncode(img[i].z) * 255.f + 0.5f);
+        colours.insert(r << 16 | g << 8 | b);
+        nonWhite += (r < 240 || g < 240 || b < 240);
+    }
+    // Text and table rules alone give grey levels; the renders, insets and heat maps give the colours.
+    EXPECT_GT(colours.size(), 500u);
+    EXPECT_GT(double(nonWhite) / double(img.size()), 0.1);
+    // The Cornell box's red wall is on screen.
+    size_t red = 0;
+    for (size_t i = 0; i < img.size(); ++i) red += img[i].x > 0.1f && img[i].x > 3 * img[i].y && img[i].x > 3 * img[i].z;
+    EXPECT_GT(red, 1000u);
+}
