@@ -1,0 +1,32 @@
+// The procedural "checker" texture of the scene format, band-limited over a footprint. Meshes
+// carry no texture coordinates, so a triangle's rest-pose (shutter-open) world position is
+// projected onto the coordinate plane most facing its normal and scaled by texture_scale: one
+// checker cell per 1/texture_scale world units. The checker is 0.5 (1 + sq(u) sq(v)) with sq the
+// +-1 square wave; its box filter over an axis-aligned box is the product of the box-filtered
+// square waves, which integrate in closed form (a triangle wave). An anisotropic footprint (two
+// vectors) is covered by up to 16 such boxes along its major axis, as a 16-tap anisotropic filter
+// does (Vaidyanathan et al. 2012, Sec. 4 use one). AAS hands in its shading cell, so its textures
+// are band-limited to its shading rate (Sec. 3.4: "input textures are automatically bandlimited").
+#pragma once
+
+#include "core/math.h"
+#include "scene/scene_desc.h"
+
+namespace wedge::raster {
+
+constexpr int kMaxTextureTaps = 16;
+/// Reflectance of the dark checker cells relative to the material's albedo.
+constexpr float kCheckerDark = 0.2f;
+
+/// sq averaged over [x - halfWidth, x + halfWidth] (the point value for halfWidth -> 0).
+float boxFilteredSquareWave(float x, float halfWidth);
+
+/// The checker (1 on light cells, 0 on dark ones) at uv, averaged over the parallelogram spanned
+/// by the footprint vectors fa and fb around uv (all in checker-cell units).
+float filteredChecker(Vec2f uv, Vec2f fa, Vec2f fb);
+
+/// The material's reflectance at rest-pose point pRest with world footprint vectors footA, footB.
+Vec3f texturedAlbedo(const scene::Material& m, const Vec3f& pRest, const Vec3f& faceNormal, const Vec3f& footA,
+                     const Vec3f& footB);
+
+}  // namespace wedge::raster

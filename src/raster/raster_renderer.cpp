@@ -1,0 +1,430 @@
+#include "raster/raster_renderer.h"
+
+#include <unordered_set>
+
+#include <tbb/parallel_for.h>
+
+#include "core/error.h"
+#include "core/parallel.h"
+#include "core/sampler.h"
+#include "raster/diffuse_shader.h"
+#include "raster/shading_cache.h"
+#include "raster/visibility.h"
+
+namespace wedge::raster {
+
+namespace {
+
+constexpr float kCanonicalTime = 0.5f;  // shutter centre; the lens centre is the other half of the pose
+constexpr uint32_t kNoRef = 0xffffffffu;
+
+struct QuadRecord {
+    uint32_t prim;
+    int32_t qx, qy;
+};
+
+
+void validate(const scene::SceneDesc& desc, const RasterOptions& opt) {
+    if (opt.spp <= 0 || opt.spp > 1024) throw Error("--spp " + std::to_string(opt.spp), "expected 1 to 1024 samples per pixel");
+    if (opt.cacheEntries == 0 || opt.cacheEntries > (size_t(1) << 30))
+        throw Error("--cache-entries " + std::to_string(opt.cacheEntries), "expected 1 to 2^30 entries");
+    uint64_t samples = uint64_t(desc.camera.width) * desc.camera.height * opt.spp;
+    if (samples >= (uint64_t(1) << 31))
+        throw Error(desc.file, "resolution x spp = " + std::to_string(samples) + " samples; at most 2^31 are supported");
+    if (!(opt.maxTriangleEdge >= 0)) throw Error("--split-edge", "expected a non-negative number of pixels");
+    if (!(opt.cutoffs.lens > 0 && opt.cutoffs.shutter > 0 && opt.cutoffs.pixel > 0))
+        throw Error("frequency cutoffs", "expected positive lens, shutter and pixel cutoffs");
+    if (opt.truthSpp < 0 || opt.truthSpp > 65536)
+        throw Error("--truth-spp " + std::to_string(opt.truthSpp), "expected 0 to 65536 samples per pixel");
+}
+
+SplitPolicy splitPolicy(const RasterOptions& opt) {
+    SplitPolicy p;
+    p.maxEdge = opt.maxTriangleEdge;
+    p.minCoc = opt.cutoffs.lens / opt.cutoffs.pixel;
+    p.minSpeed = opt.cutoffs.shutter / opt.cutoffs.pixel;
+    return p;
+}
+
+/// One scene's visibility and traversal order, shared by every shading mode and cache size.
+class Pipeline {
+public:
+    Pipeline(const scene::SceneDesc& desc, const RasterOptions& opt) : m_scene(desc, splitPolicy(opt)), m_opt(opt) {
+        Timer timer;
+        {
+            int tiles = ((m_scene.camera.width() + kTileSize - 1) / kTileSize) *
+                        ((m_scene.camera.height() + kTileSize - 1) / kTileSize);
+            Progress progress("rasterize", uint64_t(tiles), opt.progress);
+            m_vis = rasterize(m_scene, opt.spp, opt.seed, &progress);
+        }
+        m_stages.add("visibility", timer.seconds());
+        timer.reset();
+        buildOrder();
+        m_stages.add("traversal", timer.seconds());
+        m_objects = desc.meshes.size() + desc.spheres.size();
+    }
+
+    /// Visible samples grouped by triangle in scene order, each group in screen traversal order.
+    void buildOrder() {
+        std::vector<uint32_t> screen = screenTraversalOrder(m_vis.width, m_vis.height, m_vis.spp);
+        std::vector<uint64_t> offset(m_scene.triangles.size() + 1, 0);
+        for (uint32_t idx : screen)
+            if (uint32_t p = m_vis.samples[idx].prim; p != kNoPrim) ++offset[p + 1];
+        for (size_t i = 1; i < offset.size(); ++i) offset[i] += offset[i - 1];
+        m_visibleOf.assign(m_scene.triangles.size(), 0);
+        for (size_t i = 0; i < m_scene.triangles.size(); ++i) m_visibleOf[i] = offset[i + 1] - offset[i];
+        m_order.resize(offset.back());
+        for (uint32_t idx : screen)
+            if (uint32_t p = m_vis.samples[idx].prim; p != kNoPrim) m_order[offset[p]++] = idx;
+    }
+
+    std::vector<ShadingGrid> grids(ShadingMode mode, double& meanMu, double& meanPerp) const {
+        std::vector<ShadingGrid> g(m_scene.triangles.size(), ShadingGrid::pixel());
+        double sumMu = 0, sumPerp = 0, weight = 0;
+        for (size_t i = 0; i < g.size(); ++i) {
+            double mu = 1, perp = 1;
+            if (mode == ShadingMode::Adaptive) {
+                AasBounds b = aasBounds(m_scene.triangles[i], m_scene.camera, m_opt.cutoffs);
+                g[i] = ShadingGrid::fromBounds(b);
+                // Below the pixel rate the lattice is free: start it at the triangle's corner so a
+                // small triangle touches as few quads as it can. At the pixel rate keep DS's grid.
+                if (m_opt.alignGrid && (b.anisotropic || b.dPerp < 1.f)) g[i].alignTo(m_scene.triangles[i]);
+                Vec2f a = g[i].stepA(), c = g[i].stepB();
+                mu = std::hypot(a.x, a.y);
+                perp = std::hypot(c.x, c.y);
+            }
+            if (!m_scene.triangles[i].nearSafe) continue;
+            sumMu += mu * double(m_visibleOf[i]);
+            sumPerp += perp * double(m_visibleOf[i]);
+            weight += double(m_visibleOf[i]);
+        }
+        meanMu = weight > 0 ? sumMu / weight : 1;
+        meanPerp = weight > 0 ? sumPerp / weight : 1;
+        return g;
+    }
+
+    /// The (primitive, cell) key of every visible sample, aligned with m_order.
+    std::vector<CellKey> mapSamples(const std::vector<ShadingGrid>& grids) const {
+        std::vector<CellKey> keys(m_order.size());
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, m_order.size(), 4096), [&](const tbb::blocked_range<size_t>& r) {
+            for (size_t i = r.begin(); i < r.end(); ++i) {
+                const VisibilitySample& vs = m_vis.samples[m_order[i]];
+                const RasterTriangle& tri = m_scene.triangles[vs.prim];
+                if (!tri.nearSafe) {
+                    keys[i] = {vs.prim, 0, 0};
+                    continue;
+                }
+                Vec2f g = grids[vs.prim].toGrid(tri.canonicalScreen(vs.bary()));
+                keys[i] = {vs.prim, floorToInt(g.x), floorToInt(g.y)};
+            }
+        });
+        return keys;
+    }
+
+    /// Runs the cache over the keys in traversal order. With `quads` and `refs` it records the
+    /// shaded quads and, per sample index, the quad lane (4 quad + lane) holding its value.
+    CacheCounts simulate(const std::vector<CellKey>& keys, size_t entries, std::vector<QuadRecord>* quads,
+                         std::vector<uint32_t>* refs) const {
+        CacheCounts c;
+        c.shadedQuadsPerObject.assign(m_objects, 0);
+        LruShadingCache cache(entries);
+        if (refs) refs->assign(m_vis.samples.size(), kNoRef);
+        for (size_t i = 0; i < keys.size(); ++i) {
+            const CellKey& key = keys[i];
+            ++c.lookups;
+            const RasterTriangle& tri = m_scene.triangles[key.prim];
+            if (!tri.nearSafe) {  // no shading space: shaded on its own
+                ++c.misses;
+                ++c.shadedQuads;
+                ++c.shadedQuadsPerObject[tri.mesh];
+                continue;
+            }
+            if (const uint32_t* payload = cache.lookup(key)) {
+                ++c.hits;
+                if (refs) (*refs)[m_order[i]] = *payload;
+                continue;
+            }
+            ++c.misses;
+            ++c.shadedQuadsPerObject[tri.mesh];
+            uint32_t quad = uint32_t(c.shadedQuads++);
+            int32_t qx = floorDiv2(key.x), qy = floorDiv2(key.y);
+            if (quads) quads->push_back({key.prim, qx, qy});
+            int missLane = (key.x - 2 * qx) + 2 * (key.y - 2 * qy);
+            for (int lane = 0; lane < 4; ++lane)
+                if (lane != missLane)
+                    cache.insert({key.prim, 2 * qx + (lane & 1), 2 * qy + (lane >> 1)}, 4 * quad + uint32_t(lane));
+            cache.insert(key, 4 * quad + uint32_t(missLane));
+            if (refs) (*refs)[m_order[i]] = 4 * quad + uint32_t(missLane);
+        }
+        c.shaderInvocations = 4 * c.shadedQuads;
+        c.evictions = cache.evictions();
+        return c;
+    }
+
+    uint64_t distinctQuads(const std::vector<CellKey>& keys) const {
+        std::unordered_set<CellKey, CellKeyHash> seen;
+        seen.reserve(keys.size() / 4 + 16);
+        uint64_t fallback = 0;
+        for (const CellKey& k : keys) {
+            if (!m_scene.triangles[k.prim].nearSafe) {
+                ++fallback;
+                continue;
+            }
+            seen.insert({k.prim, floorDiv2(k.x), floorDiv2(k.y)});
+        }
+        return seen.size() + fallback;
+    }
+
+    std::vector<Vec3f> shadeQuads(const std::vector<QuadRecord>& quads, const std::vector<ShadingGrid>& grids) const {
+        std::vector<Vec3f> values(quads.size() * 4);
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, quads.size(), 256), [&](const tbb::blocked_range<size_t>& r) {
+            for (size_t q = r.begin(); q < r.end(); ++q) {
+                const QuadRecord& rec = quads[q];
+                const RasterTriangle& tri = m_scene.triangles[rec.prim];
+                for (int lane = 0; lane < 4; ++lane) {
+                    ShadingPoint sp = cellShadingPoint(tri, grids[rec.prim], 2 * rec.qx + (lane & 1), 2 * rec.qy + (lane >> 1));
+                    Vec3f footA, footB;
+                    worldFootprint(tri, m_scene.camera, kCanonicalTime, sp.screen, sp.stepA, sp.stepB, footA, footB);
+                    values[4 * q + lane] = shadeSurface(m_scene, tri, sp.bary, kCanonicalTime, footA, footB);
+                }
+            }
+        });
+        return values;
+    }
+
+    /// Shades a sample at its own surface point (the reference), textures filtered over one pixel
+    /// of the canonical pose like DS; a triangle without a canonical pose is shaded at the sample's
+    /// own time.
+    Vec3f shadeOwnSample(uint32_t idx) const {
+        const VisibilitySample& vs = m_vis.samples[idx];
+        const RasterTriangle& tri = m_scene.triangles[vs.prim];
+        Vec3f bary = vs.bary(), footA, footB;
+        if (tri.nearSafe) {
+            worldFootprint(tri, m_scene.camera, kCanonicalTime, tri.canonicalScreen(bary), {1, 0}, {0, 1}, footA, footB);
+            return shadeSurface(m_scene, tri, bary, kCanonicalTime, footA, footB);
+        }
+        int pixel = int(idx / uint32_t(m_vis.spp)), s = int(idx % uint32_t(m_vis.spp));
+        SamplePoint sp = samplePoint(m_vis.seed, m_vis.width, pixel % m_vis.width, pixel / m_vis.width, uint32_t(s));
+        worldFootprint(tri, m_scene.camera, sp.tau, {sp.px, sp.py}, {1, 0}, {0, 1}, footA, footB);
+        return shadeSurface(m_scene, tri, bary, sp.tau, footA, footB);
+    }
+
+    /// Box-filters the samples of each pixel; `value(idx)` gives a visible sample's radiance.
+    template <class Value>
+    Image3f resolve(Value&& value) const {
+        Image3f img(m_vis.width, m_vis.height, Vec3f(0.f));
+        parallelRows(m_vis.height, [&](int y) {
+            for (int x = 0; x < m_vis.width; ++x) {
+                Vec3f sum(0.f);
+                for (int s = 0; s < m_vis.spp; ++s) {
+                    uint32_t idx = uint32_t(m_vis.index(x, y, s));
+                    if (m_vis.samples[idx].prim != kNoPrim) sum += value(idx);
+                }
+                img(x, y) = sum / float(m_vis.spp);
+            }
+        });
+        return img;
+    }
+
+    Image3f referenceImage() const {
+        return resolve([&](uint32_t idx) { return shadeOwnSample(idx); });
+    }
+
+    /// A decoupled mode at one cache size: counts, image and stats.
+    RasterResult renderDecoupled(ShadingMode mode, size_t entries) {
+        RasterResult r;
+        StageTimes stages;
+        Timer timer;
+        double meanMu = 1, meanPerp = 1;
+        std::vector<ShadingGrid> g = grids(mode, meanMu, meanPerp);
+        std::vector<CellKey> keys = mapSamples(g);
+        stages.add("mapping", timer.seconds());
+        timer.reset();
+        std::vector<QuadRecord> quads;
+        std::vector<uint32_t> refs;
+        CacheCounts counts = simulate(keys, entries, &quads, &refs);
+        stages.add("cache", timer.seconds());
+        timer.reset();
+        std::vector<Vec3f> values = shadeQuads(quads, g);
+        stages.add("shading", timer.seconds());
+        timer.reset();
+        r.image = resolve([&](uint32_t idx) {
+            return refs[idx] != kNoRef ? values[refs[idx]] : shadeOwnSample(idx);  // kNoRef: near-plane fallback
+        });
+        stages.add("resolve", timer.seconds());
+        r.stats = baseStats(mode, entries);
+        r.stats.cache = counts;
+        r.stats.meanSpacingMu = meanMu;
+        r.stats.meanSpacingPerp = meanPerp;
+        r.stats.quadsUnboundedCache = distinctQuads(keys);
+        for (auto& [name, s] : stages.stages()) r.stats.stages.add(name, s);
+        r.stats.seconds = 0;
+        for (auto& [name, s] : r.stats.stages.stages()) r.stats.seconds += s;
+        return r;
+    }
+
+    RasterResult renderReference() {
+        RasterResult r;
+        Timer timer;
+        r.image = referenceImage();
+        r.stats = baseStats(ShadingMode::Reference, 0);
+        r.stats.stages.add("shading", timer.seconds());
+        r.stats.cache.lookups = m_order.size();
+        r.stats.cache.shaderInvocations = m_order.size();
+        r.stats.cache.shadedQuads = (m_order.size() + 3) / 4;  // lanes packed four to a quad
+        r.stats.quadsUnboundedCache = r.stats.cache.shadedQuads;
+        r.stats.relMse = 0;
+        for (auto& [name, s] : r.stats.stages.stages()) r.stats.seconds += s;
+        return r;
+    }
+
+    /// Counts only, for the sweep.
+    CacheCounts countOnly(const std::vector<CellKey>& keys, size_t entries) const {
+        return simulate(keys, entries, nullptr, nullptr);
+    }
+
+    RasterStats baseStats(ShadingMode mode, size_t entries) const {
+        RasterStats s;
+        s.shading = mode;
+        s.cacheEntries = entries;
+        s.width = m_vis.width;
+        s.height = m_vis.height;
+        s.spp = m_vis.spp;
+        s.triangles = m_scene.triangles.size();
+        s.culledTriangles = m_scene.culledTriangles;
+        s.maxTriangleEdge = m_opt.maxTriangleEdge;
+        for (size_t i = 0; i < m_scene.triangles.size(); ++i)
+            if (!m_scene.triangles[i].nearSafe) {
+                ++s.fallbackTriangles;
+                s.fallbackSamples += m_visibleOf[i];
+            }
+        s.samples = m_vis.samples.size();
+        s.visibleSamples = m_vis.visibleSamples;
+        s.sampleTests = m_vis.sampleTests;
+        s.slabRejects = m_vis.slabRejects;
+        for (auto& [name, sec] : m_stages.stages()) s.stages.add(name, sec);
+        return s;
+    }
+
+private:
+    RasterScene m_scene;
+    RasterOptions m_opt;
+    VisibilityBuffer m_vis;
+    std::vector<uint32_t> m_order;       // visible sample indices in traversal order
+    std::vector<uint64_t> m_visibleOf;   // visible samples per triangle
+    StageTimes m_stages;                 // visibility and traversal, shared by every mode
+    size_t m_objects = 0;
+};
+
+}  // namespace
+
+std::string shadingModeName(ShadingMode mode) {
+    switch (mode) {
+        case ShadingMode::Reference: return "reference";
+        case ShadingMode::Decoupled: return "ds";
+        case ShadingMode::Adaptive: return "aas";
+    }
+    return "?";
+}
+
+ShadingMode parseShadingMode(const std::string& name, const std::string& where) {
+    if (name == "ds") return ShadingMode::Decoupled;
+    if (name == "aas") return ShadingMode::Adaptive;
+    if (name == "reference") return ShadingMode::Reference;
+    throw Error(where, "unknown shading mode '" + name + "' (expected ds, aas or reference)");
+}
+
+double relMse(const Image3f& x, const Image3f& reference) {
+    if (!x.sameSize(reference) || x.empty()) throw Error("relMSE", "image size mismatch");
+    double sum = 0;  // sequential: the same value for any thread count
+    for (size_t i = 0; i < x.size(); ++i)
+        for (int c = 0; c < 3; ++c) {
+            double d = double(x[i][c]) - double(reference[i][c]);
+            sum += d * d / (double(reference[i][c]) * reference[i][c] + 0.01);
+        }
+    return sum / (3.0 * double(x.size()));
+}
+
+RasterResult renderRaster(const scene::SceneDesc& desc, const RasterOptions& options) {
+    validate(desc, options);
+    Timer total;
+    Pipeline pipeline(desc, options);
+    RasterResult r = options.shading == ShadingMode::Reference
+                         ? pipeline.renderReference()
+                         : pipeline.renderDecoupled(options.shading, options.cacheEntries);
+    r.stats.seconds = total.seconds();
+    if (options.computeReference && options.shading != ShadingMode::Reference) {
+        Timer t;
+        r.reference = pipeline.referenceImage();
+        r.stats.relMse = relMse(r.image, r.reference);
+        r.stats.referenceSeconds = t.seconds();
+    }
+    if (options.truthSpp > 0) {
+        Timer t;
+        r.truth = renderTruth(desc, options);
+        r.stats.relMseTruth = relMse(r.image, r.truth);
+        r.stats.truthSeconds = t.seconds();
+    }
+    return r;
+}
+
+Image3f renderTruth(const scene::SceneDesc& desc, const RasterOptions& options) {
+    // Passes of at most 64 spp with their own seeds, averaged: memory stays that of one pass.
+    constexpr int kPassSpp = 64;
+    Image3f sum(desc.camera.width, desc.camera.height, Vec3f(0.f));
+    int done = 0;
+    for (int pass = 0; done < options.truthSpp; ++pass) {
+        RasterOptions o = options;
+        o.spp = std::min(kPassSpp, options.truthSpp - done);
+        o.seed = hashCombine(options.seed, 0x7275u + uint32_t(pass));
+        o.progress = false;
+        validate(desc, o);
+        Pipeline p(desc, o);
+        Image3f img = p.referenceImage();
+        for (size_t i = 0; i < sum.size(); ++i) sum[i] += img[i] * float(o.spp);
+        done += o.spp;
+    }
+    for (size_t i = 0; i < sum.size(); ++i) sum[i] = sum[i] / float(done);
+    return sum;
+}
+
+SweepResult sweepCache(const scene::SceneDesc& desc, const RasterOptions& options, const std::vector<size_t>& cacheSizes) {
+    if (cacheSizes.empty()) throw Error("--sweep-cache", "expected at least one cache size");
+    size_t largest = 0;
+    for (size_t k : cacheSizes) {
+        RasterOptions o = options;
+        o.cacheEntries = k;
+        validate(desc, o);
+        largest = std::max(largest, k);
+    }
+    Timer total;
+    Pipeline pipeline(desc, options);
+    SweepResult sweep;
+    sweep.rows.resize(cacheSizes.size());
+    for (size_t i = 0; i < cacheSizes.size(); ++i) sweep.rows[i].cacheEntries = cacheSizes[i];
+    for (ShadingMode mode : {ShadingMode::Decoupled, ShadingMode::Adaptive}) {
+        RasterResult full = pipeline.renderDecoupled(mode, largest);
+        double mu, perp;
+        std::vector<CellKey> keys = pipeline.mapSamples(pipeline.grids(mode, mu, perp));
+        for (size_t i = 0; i < cacheSizes.size(); ++i) {
+            CacheCounts c = cacheSizes[i] == largest ? full.stats.cache : pipeline.countOnly(keys, cacheSizes[i]);
+            (mode == ShadingMode::Decoupled ? sweep.rows[i].ds : sweep.rows[i].aas) = c;
+        }
+        (mode == ShadingMode::Decoupled ? sweep.dsImage : sweep.aasImage) = std::move(full.image);
+        (mode == ShadingMode::Decoupled ? sweep.ds : sweep.aas) = full.stats;
+    }
+    sweep.reference = pipeline.referenceImage();
+    sweep.ds.relMse = relMse(sweep.dsImage, sweep.reference);
+    sweep.aas.relMse = relMse(sweep.aasImage, sweep.reference);
+    sweep.aasVsDsRelMse = relMse(sweep.aasImage, sweep.dsImage);
+    if (options.truthSpp > 0) {
+        sweep.truth = renderTruth(desc, options);
+        sweep.ds.relMseTruth = relMse(sweep.dsImage, sweep.truth);
+        sweep.aas.relMseTruth = relMse(sweep.aasImage, sweep.truth);
+        sweep.referenceRelMseTruth = relMse(sweep.reference, sweep.truth);
+    }
+    sweep.seconds = total.seconds();
+    return sweep;
+}
+
+}  // namespace wedge::raster

@@ -1,0 +1,119 @@
+#include "raster/raster_report.h"
+
+#include <cstdio>
+#include <sstream>
+
+#include "raster/plot.h"
+
+namespace wedge::raster {
+
+namespace {
+
+nlohmann::json countsJson(const CacheCounts& c) {
+    return {{"lookups", c.lookups},
+            {"hits", c.hits},
+            {"misses", c.misses},
+            {"evictions", c.evictions},
+            {"shaded_quads", c.shadedQuads},
+            {"shader_invocations", c.shaderInvocations}};
+}
+
+}  // namespace
+
+nlohmann::json statsJson(const RasterStats& s, const std::string& sceneName) {
+    nlohmann::json j;
+    j["scene"] = sceneName;
+    j["shading"] = shadingModeName(s.shading);
+    j["cache_entries"] = s.cacheEntries;
+    j["resolution"] = {s.width, s.height};
+    j["spp"] = s.spp;
+    j["triangles"] = s.triangles;
+    j["split_edge_px"] = s.maxTriangleEdge;
+    j["culled_triangles"] = s.culledTriangles;
+    j["near_plane_fallback_triangles"] = s.fallbackTriangles;
+    j["samples"] = s.samples;
+    j["visible_samples"] = s.visibleSamples;
+    j["samples_tested"] = s.sampleTests;
+    j["slab_rejects"] = s.slabRejects;
+    j["near_plane_fallback_samples"] = s.fallbackSamples;
+    j["shaded_quads"] = s.cache.shadedQuads;
+    j["shader_invocations"] = s.cache.shaderInvocations;
+    j["lookups"] = s.cache.lookups;
+    j["hits"] = s.cache.hits;
+    j["misses"] = s.cache.misses;
+    j["evictions"] = s.cache.evictions;
+    j["hit_rate"] = s.cache.lookups ? double(s.cache.hits) / double(s.cache.lookups) : 0.0;
+    j["shaded_quads_unbounded_cache"] = s.quadsUnboundedCache;
+    j["shaded_quads_per_object"] = s.cache.shadedQuadsPerObject;
+    j["mean_grid_spacing_px"] = {{"along_motion", s.meanSpacingMu}, {"across_motion", s.meanSpacingPerp}};
+    if (s.relMse >= 0) j["rel_mse_vs_reference"] = s.relMse;
+    else j["rel_mse_vs_reference"] = nullptr;
+    if (s.relMseTruth >= 0) {
+        j["rel_mse_vs_truth"] = s.relMseTruth;
+        j["truth_seconds"] = s.truthSeconds;
+    }
+    j["seconds"] = s.seconds;
+    j["reference_seconds"] = s.referenceSeconds;
+    nlohmann::json stages = nlohmann::json::object();
+    for (auto& [name, sec] : s.stages.stages()) stages[name] = sec;
+    j["stage_seconds"] = stages;
+    return j;
+}
+
+std::string sweepCsv(const SweepResult& sweep) {
+    std::ostringstream out;
+    out << "cache_entries,ds_shaded_quads,ds_hits,ds_misses,aas_shaded_quads,aas_hits,aas_misses,aas_over_ds\n";
+    for (const SweepRow& r : sweep.rows) {
+        double ratio = r.ds.shadedQuads ? double(r.aas.shadedQuads) / double(r.ds.shadedQuads) : 0.0;
+        char buf[64];
+        std::snprintf(buf, sizeof buf, "%.4f", ratio);
+        out << r.cacheEntries << ',' << r.ds.shadedQuads << ',' << r.ds.hits << ',' << r.ds.misses << ','
+            << r.aas.shadedQuads << ',' << r.aas.hits << ',' << r.aas.misses << ',' << buf << '\n';
+    }
+    return out.str();
+}
+
+nlohmann::json sweepJson(const SweepResult& sweep, const std::string& sceneName) {
+    nlohmann::json j;
+    j["scene"] = sceneName;
+    nlohmann::json rows = nlohmann::json::array();
+    for (const SweepRow& r : sweep.rows)
+        rows.push_back({{"cache_entries", r.cacheEntries}, {"ds", countsJson(r.ds)}, {"aas", countsJson(r.aas)}});
+    j["rows"] = rows;
+    j["ds"] = statsJson(sweep.ds, sceneName);
+    j["aas"] = statsJson(sweep.aas, sceneName);
+    j["rel_mse_aas_vs_ds"] = sweep.aasVsDsRelMse;
+    if (sweep.referenceRelMseTruth >= 0) j["rel_mse_reference_vs_truth"] = sweep.referenceRelMseTruth;
+    j["seconds"] = sweep.seconds;
+    return j;
+}
+
+Image3f sweepPlot(const SweepResult& sweep, const std::string& sceneName) {
+    PlotSpec spec;
+    std::string name = sceneName;
+    if (auto slash = name.find_last_of('/'); slash != std::string::npos) name = name.substr(slash + 1);
+    spec.title = "SHADED QUADS VS CACHE SIZE: " + name;
+    spec.xLabel = "CACHE ENTRIES";
+    spec.yLabel = "SHADED QUADS";
+    const Vec3f blue(0.12f, 0.35f, 0.75f), orange(0.90f, 0.45f, 0.05f);
+    PlotSeries ds{"DS", blue, {}, {}}, aas{"AAS", orange, {}, {}};
+    PlotSeries dsInf{"DS, UNBOUNDED", blue * 0.5f + Vec3f(0.5f), {}, {}, true};
+    PlotSeries aasInf{"AAS, UNBOUNDED", orange * 0.5f + Vec3f(0.5f), {}, {}, true};
+    for (const SweepRow& r : sweep.rows) {
+        double k = double(r.cacheEntries);
+        ds.x.push_back(k);
+        ds.y.push_back(double(r.ds.shadedQuads));
+        aas.x.push_back(k);
+        aas.y.push_back(double(r.aas.shadedQuads));
+    }
+    if (!sweep.rows.empty()) {
+        double k0 = double(sweep.rows.front().cacheEntries), k1 = double(sweep.rows.back().cacheEntries);
+        dsInf.x = aasInf.x = {std::min(k0, k1), std::max(k0, k1)};
+        dsInf.y = {double(sweep.ds.quadsUnboundedCache), double(sweep.ds.quadsUnboundedCache)};
+        aasInf.y = {double(sweep.aas.quadsUnboundedCache), double(sweep.aas.quadsUnboundedCache)};
+    }
+    spec.series = {ds, aas, dsInf, aasInf};
+    return drawLinePlot(spec);
+}
+
+}  // namespace wedge::raster
