@@ -35,6 +35,7 @@ constexpr Glyph kFont[] = {
     {')', {0x08, 0x04, 0x02, 0x02, 0x02, 0x04, 0x08}}, {'/', {0x00, 0x01, 0x02, 0x04, 0x08, 0x10, 0x00}},
     {':', {0x00, 0x0C, 0x0C, 0x00, 0x0C, 0x0C, 0x00}}, {'%', {0x18, 0x19, 0x02, 0x04, 0x08, 0x13, 0x03}},
     {'=', {0x00, 0x00, 0x1F, 0x00, 0x1F, 0x00, 0x00}}, {'+', {0x00, 0x04, 0x04, 0x1F, 0x04, 0x04, 0x00}},
+    {'_', {0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x1F}},
 };
 
 const Glyph* findGlyph(char c) {
@@ -189,7 +190,11 @@ Image3f drawLinePlot(const PlotSpec& spec) {
     for (const auto& s : spec.series) {
         int lw = textWidth(s.label, 2);
         int lx = left + pw - 16 - lw - 40;
-        drawSegment(img, float(lx), float(ly + 7), float(lx + 30), float(ly + 7), s.dashed ? 2.f : 2.5f, s.colour);
+        if (s.dashed) {
+            for (int k = 0; k < 3; ++k) drawSegment(img, float(lx + 12 * k), float(ly + 7), float(lx + 12 * k + 6), float(ly + 7), 2.f, s.colour);
+        } else {
+            drawSegment(img, float(lx), float(ly + 7), float(lx + 30), float(ly + 7), 2.5f, s.colour);
+        }
         if (!s.dashed) drawDisc(img, float(lx + 15), float(ly + 7), 4.f, s.colour);
         drawText(img, lx + 40, ly, s.label, 2, text);
         ly += 22;

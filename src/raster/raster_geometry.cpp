@@ -21,6 +21,34 @@ Bounds2 boundsOver(const RasterTriangle& t, const RasterCamera& cam, float tauA,
     return b;
 }
 
+/// Screen bounds over [tauA, tauB] and the lens of the part of a triangle in front of the near
+/// plane, for a triangle that crosses it but does not move in depth: every surface point then keeps
+/// its depth, so the part in front is the same set of points at all times and each point's image is
+/// linear in tau and in the lens coordinate; the clipped polygons at the interval ends bound it.
+Bounds2 clippedBoundsOver(const RasterTriangle& t, const RasterCamera& cam, float tauA, float tauB) {
+    Bounds2 b;
+    for (float tau : {tauA, tauB}) {
+        Vec3f in[3] = {t.p[0] + t.motion * tau, t.p[1] + t.motion * tau, t.p[2] + t.motion * tau};
+        for (int k = 0; k < 3; ++k) {
+            const Vec3f& a = in[k];
+            const Vec3f& c = in[(k + 1) % 3];
+            auto extend = [&](const Vec3f& q) {
+                Vec2f s = cam.project(q);
+                float coc = std::abs(cam.circleOfConfusion(q.z));
+                b.extend(s.x - coc, s.y - coc);
+                b.extend(s.x + coc, s.y + coc);
+            };
+            if (a.z >= kNearDepth) extend(a);
+            if ((a.z >= kNearDepth) != (c.z >= kNearDepth)) {
+                Vec3f q = a + (c - a) * ((kNearDepth - a.z) / (c.z - a.z));
+                q.z = kNearDepth;
+                extend(q);
+            }
+        }
+    }
+    return b;
+}
+
 void tessellateSphere(const scene::Sphere& s, std::vector<Vec3f>& pos, std::vector<Vec3f>& nrm,
                       std::vector<uint32_t>& idx) {
     uint32_t base = uint32_t(pos.size());
@@ -123,6 +151,13 @@ RasterScene::RasterScene(const scene::SceneDesc& desc, const SplitPolicy& policy
             split = policy.maxEdge > 0 && maxEdge > policy.maxEdge && depth < kMaxSplits && blurred(t);
         } else {
             split = depth < kMaxNearSplits;
+            if (t.motion.z == 0.f) {  // the clipped part has exact bounds; else the whole screen
+                t.bounds = clippedBoundsOver(t, camera, 0.f, 1.f);
+                if (offScreen(t.bounds)) {
+                    ++culledTriangles;
+                    return;
+                }
+            }
         }
         if (split) {
             SplitVertex m01 = midpoint(v[0], v[1], smooth), m12 = midpoint(v[1], v[2], smooth),
@@ -134,6 +169,15 @@ RasterScene::RasterScene(const scene::SceneDesc& desc, const SplitPolicy& policy
         if (t.nearSafe) {
             for (int k = 0; k < kTimeSlabs; ++k)
                 t.slab[k] = boundsOver(t, camera, float(k) / kTimeSlabs, float(k + 1) / kTimeSlabs);
+            for (int k = 0; k <= kTimeSlabs; ++k)
+                for (int i = 0; i < 3; ++i) {
+                    Vec3f q = t.p[i] + t.motion * (float(k) / kTimeSlabs);
+                    Vec2f s = camera.project(q);
+                    t.lensLine[k][i] = {s.x, s.y, camera.circleOfConfusion(q.z)};
+                }
+        } else if (t.motion.z == 0.f) {
+            for (int k = 0; k < kTimeSlabs; ++k)
+                t.slab[k] = clippedBoundsOver(t, camera, float(k) / kTimeSlabs, float(k + 1) / kTimeSlabs);
         } else {
             t.bounds = screen;
             for (auto& s : t.slab) s = screen;

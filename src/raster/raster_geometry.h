@@ -65,6 +65,9 @@ struct RasterTriangle {
     bool nearSafe = true;
     Bounds2 bounds;              // pixels, over the whole shutter and lens
     Bounds2 slab[kTimeSlabs];    // pixels, over [k, k+1] / kTimeSlabs of the shutter and the lens
+    // At shutter time k / kTimeSlabs: each vertex's pinhole image (x, y) and circle of confusion
+    // phi (z); at lens point (lu, lv) the vertex is imaged at (x + phi lu, y - phi lv).
+    Vec3f lensLine[kTimeSlabs + 1][3];
 
     // Canonical pose: pinhole image (pixels) and depth of each vertex at shutter centre.
     Vec2f sCanon[3];

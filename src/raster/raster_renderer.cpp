@@ -301,7 +301,7 @@ public:
         s.samples = m_vis.samples.size();
         s.visibleSamples = m_vis.visibleSamples;
         s.sampleTests = m_vis.sampleTests;
-        s.slabRejects = m_vis.slabRejects;
+        s.boundRejects = m_vis.boundRejects;
         for (auto& [name, sec] : m_stages.stages()) s.stages.add(name, sec);
         return s;
     }

@@ -65,7 +65,7 @@ struct RasterStats {
     int width = 0, height = 0, spp = 0;
     size_t triangles = 0, culledTriangles = 0, fallbackTriangles = 0;
     float maxTriangleEdge = 0;
-    uint64_t samples = 0, visibleSamples = 0, sampleTests = 0, slabRejects = 0, fallbackSamples = 0;
+    uint64_t samples = 0, visibleSamples = 0, sampleTests = 0, boundRejects = 0, fallbackSamples = 0;
     CacheCounts cache;
     uint64_t quadsUnboundedCache = 0;  // distinct (primitive, quad) keys: the shaded quads of an infinite cache
     double meanSpacingMu = 1, meanSpacingPerp = 1;  // pixels; grid spacing averaged over visible samples

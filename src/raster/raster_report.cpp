@@ -34,7 +34,7 @@ nlohmann::json statsJson(const RasterStats& s, const std::string& sceneName) {
     j["samples"] = s.samples;
     j["visible_samples"] = s.visibleSamples;
     j["samples_tested"] = s.sampleTests;
-    j["slab_rejects"] = s.slabRejects;
+    j["bound_rejects"] = s.boundRejects;
     j["near_plane_fallback_samples"] = s.fallbackSamples;
     j["shaded_quads"] = s.cache.shadedQuads;
     j["shader_invocations"] = s.cache.shaderInvocations;
@@ -97,8 +97,8 @@ Image3f sweepPlot(const SweepResult& sweep, const std::string& sceneName) {
     spec.yLabel = "SHADED QUADS";
     const Vec3f blue(0.12f, 0.35f, 0.75f), orange(0.90f, 0.45f, 0.05f);
     PlotSeries ds{"DS", blue, {}, {}}, aas{"AAS", orange, {}, {}};
-    PlotSeries dsInf{"DS, UNBOUNDED", blue * 0.5f + Vec3f(0.5f), {}, {}, true};
-    PlotSeries aasInf{"AAS, UNBOUNDED", orange * 0.5f + Vec3f(0.5f), {}, {}, true};
+    PlotSeries dsInf{"DS, UNBOUNDED CACHE", blue * 0.7f + Vec3f(0.3f), {}, {}, true};
+    PlotSeries aasInf{"AAS, UNBOUNDED CACHE", orange * 0.7f + Vec3f(0.3f), {}, {}, true};
     for (const SweepRow& r : sweep.rows) {
         double k = double(r.cacheEntries);
         ds.x.push_back(k);

@@ -3,8 +3,11 @@
 // samples whose film offset, lens point (concentric disc) and shutter time come from the
 // deterministic PixelSampler (pairs 0, 1, 2), so the result does not depend on the thread count.
 // Triangles are binned into 8x8-pixel tiles by their conservative screen bounds over the whole
-// shutter and lens (raster_geometry.h); inside a tile a sample is tested only against triangles
-// whose bounds for its time slab contain it. The coverage test intersects the sample's lens ray
+// shutter and lens (raster_geometry.h). Inside a tile the samples are bucketed by time slab and
+// lens region; for each slab a triangle gets the lens interval (per axis) from which its bounding
+// box can reach the tile (the vertex images move linearly with the lens coordinate, so the interval
+// follows from the six vertex images at the slab ends), and only the samples of the buckets it
+// overlaps, inside its slab bounds and lens interval, are tested. The coverage test intersects the sample's lens ray
 // with the triangle at the sample's time (the ray is moved by -motion t instead of the triangle),
 // which is the 5D edge-function test with the thin-lens shear, and the depth test keeps the
 // nearest hit (ties: the earlier triangle). A surviving sample stores its triangle and the
@@ -51,7 +54,7 @@ struct VisibilityBuffer {
     uint32_t seed = 0;
     std::vector<VisibilitySample> samples;  // index ((y * width) + x) * spp + s
     uint64_t sampleTests = 0;   // sample-triangle coverage tests run
-    uint64_t slabRejects = 0;   // sample-triangle pairs inside a tile rejected by the time-slab bounds
+    uint64_t boundRejects = 0;  // sample-triangle pairs in a visited bucket rejected by the slab and lens bounds
     uint64_t visibleSamples = 0;
 
     size_t index(int x, int y, int s) const { return (size_t(y) * width + x) * spp + s; }
