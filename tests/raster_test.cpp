@@ -210,7 +210,51 @@ TEST(Raster, ImageDoesNotDependOnCacheSizeOrThreadCount) {
     EXPECT_EQ(a.stats.sampleTests, c.stats.sampleTests);
 }
 
+TEST(Raster, NearPlaneCrossingGeometryKeepsItsSamples) {
+    // A floor that runs behind the camera crosses the near plane; the same floor cut just in front
+    // of the camera does not. The clipped bounds must not lose a sample, and the reference shading
+    // does not depend on how the floor was split.
+    auto floorScene = [](float zNear) {
+        scene::SceneDesc d = testScene(32, Vec3f(0.f), 0.f, 3.f, false);
+        d.meshes.clear();
+        scene::TriangleMesh m;
+        scene::appendQuad(m, {-4, -1, zNear}, {0, 0, -20 - zNear}, {8, 0, 0}, 0);
+        d.meshes.push_back(m);
+        return d;
+    };
+    RasterOptions o = opts(ShadingMode::Reference, 1, 4);
+    RasterResult crossing = renderRaster(floorScene(5.f), o), cut = renderRaster(floorScene(-0.01f), o);
+    EXPECT_GT(crossing.stats.visibleSamples, 1000u);
+    EXPECT_EQ(crossing.stats.visibleSamples, cut.stats.visibleSamples);
+    EXPECT_LT(maxAbsDiff(crossing.image, cut.image), 1e-4);
+    EXPECT_LT(crossing.stats.sampleTests, 4 * crossing.stats.samples) << "bounds of the clipped floor stay tight";
+}
+
 // --- Pieces -----------------------------------------------------------------------------------
+
+TEST(RasterCamera, LensShearMatchesTheThinLensRay) {
+    // A point seen from lens point (lu, lv) lands at (x0 + phi lu, y0 - phi lv): the ray from that
+    // lens point through the film position must pass through the point.
+    scene::CameraDesc cd;
+    cd.position = {0.3f, 0.2f, 4};
+    cd.lookAt = {0, 0, 0};
+    cd.width = 64;
+    cd.height = 48;
+    cd.apertureRadius = 0.2f;
+    cd.focusDistance = 3.f;
+    RasterCamera cam(cd);
+    Vec3f p = cam.toCamera({0.4f, -0.3f, 0.5f});
+    for (Vec2f lens : {Vec2f{0.5f, -0.25f}, Vec2f{-0.8f, 0.1f}}) {
+        Vec2f s0 = cam.project(p);
+        float phi = cam.circleOfConfusion(p.z);
+        Vec3f origin, dir;
+        cam.ray(s0.x + phi * lens.x, s0.y - phi * lens.y, lens.x, lens.y, origin, dir);
+        float t = (p.z - origin.z) / dir.z;
+        Vec3f q = origin + dir * t;
+        EXPECT_NEAR(q.x, p.x, 1e-4f);
+        EXPECT_NEAR(q.y, p.y, 1e-4f);
+    }
+}
 
 TEST(RasterCache, EvictsLeastRecentlyUsed) {
     LruShadingCache cache(2);

@@ -98,8 +98,8 @@ void runSweep(const RasterArgs& a) {
             std::printf("%-8zu %14llu %14llu %9.3f\n", r.cacheEntries, (unsigned long long)r.ds.shadedQuads,
                         (unsigned long long)r.aas.shadedQuads,
                         r.ds.shadedQuads ? double(r.aas.shadedQuads) / double(r.ds.shadedQuads) : 0.0);
-        std::printf("relMSE vs reference: ds %.5f, aas %.5f; aas vs ds %.5f", sweep.ds.relMse, sweep.aas.relMse,
-                    sweep.aasVsDsRelMse);
+        std::printf("relMSE vs reference: ds %.5f, aas %.5f; aas vs ds %.5f (PSNR %.1f dB)", sweep.ds.relMse,
+                    sweep.aas.relMse, sweep.aasVsDsRelMse, sweep.aasVsDsPsnr);
         if (!sweep.truth.empty())
             std::printf("; vs truth: ds %.5f, aas %.5f, reference %.5f", sweep.ds.relMseTruth, sweep.aas.relMseTruth,
                         sweep.referenceRelMseTruth);

@@ -345,6 +345,18 @@ double relMse(const Image3f& x, const Image3f& reference) {
     return sum / (3.0 * double(x.size()));
 }
 
+double psnr(const Image3f& x, const Image3f& reference) {
+    if (!x.sameSize(reference) || x.empty()) throw Error("PSNR", "image size mismatch");
+    double sum = 0;
+    for (size_t i = 0; i < x.size(); ++i)
+        for (int c = 0; c < 3; ++c) {
+            double d = std::clamp(double(x[i][c]), 0.0, 1.0) - std::clamp(double(reference[i][c]), 0.0, 1.0);
+            sum += d * d;
+        }
+    double mse = sum / (3.0 * double(x.size()));
+    return mse > 0 ? 10.0 * std::log10(1.0 / mse) : 99.0;
+}
+
 RasterResult renderRaster(const scene::SceneDesc& desc, const RasterOptions& options) {
     validate(desc, options);
     Timer total;
@@ -357,6 +369,7 @@ RasterResult renderRaster(const scene::SceneDesc& desc, const RasterOptions& opt
         Timer t;
         r.reference = pipeline.referenceImage();
         r.stats.relMse = relMse(r.image, r.reference);
+        r.stats.psnr = psnr(r.image, r.reference);
         r.stats.referenceSeconds = t.seconds();
     }
     if (options.truthSpp > 0) {
@@ -416,7 +429,10 @@ SweepResult sweepCache(const scene::SceneDesc& desc, const RasterOptions& option
     sweep.reference = pipeline.referenceImage();
     sweep.ds.relMse = relMse(sweep.dsImage, sweep.reference);
     sweep.aas.relMse = relMse(sweep.aasImage, sweep.reference);
+    sweep.ds.psnr = psnr(sweep.dsImage, sweep.reference);
+    sweep.aas.psnr = psnr(sweep.aasImage, sweep.reference);
     sweep.aasVsDsRelMse = relMse(sweep.aasImage, sweep.dsImage);
+    sweep.aasVsDsPsnr = psnr(sweep.aasImage, sweep.dsImage);
     if (options.truthSpp > 0) {
         sweep.truth = renderTruth(desc, options);
         sweep.ds.relMseTruth = relMse(sweep.dsImage, sweep.truth);

@@ -70,6 +70,7 @@ struct RasterStats {
     uint64_t quadsUnboundedCache = 0;  // distinct (primitive, quad) keys: the shaded quads of an infinite cache
     double meanSpacingMu = 1, meanSpacingPerp = 1;  // pixels; grid spacing averaged over visible samples
     double relMse = -1;     // against the reference (shading every sample); -1 when not computed
+    double psnr = 0;        // dB, against the same reference
     double relMseTruth = -1;  // against the converged reference (truthSpp); -1 when not computed
     double truthSeconds = 0;
     double seconds = 0;     // the render, without the reference
@@ -95,7 +96,7 @@ struct SweepResult {
     std::vector<SweepRow> rows;
     RasterStats ds, aas;  // full stats of each mode at the largest cache size
     Image3f dsImage, aasImage, reference, truth;
-    double aasVsDsRelMse = 0;
+    double aasVsDsRelMse = 0, aasVsDsPsnr = 0;
     double referenceRelMseTruth = -1;
     double seconds = 0;
 };
@@ -110,5 +111,7 @@ Image3f renderTruth(const scene::SceneDesc& desc, const RasterOptions& options);
 
 /// mean over pixels and channels of (x - r)^2 / (r^2 + 0.01) (NOTES.md, no factor 0.5).
 double relMse(const Image3f& x, const Image3f& reference);
+/// PSNR in dB of the images clamped to [0, 1] (linear radiance, exposure 1; NOTES.md).
+double psnr(const Image3f& x, const Image3f& reference);
 
 }  // namespace wedge::raster

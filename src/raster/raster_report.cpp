@@ -46,8 +46,12 @@ nlohmann::json statsJson(const RasterStats& s, const std::string& sceneName) {
     j["shaded_quads_unbounded_cache"] = s.quadsUnboundedCache;
     j["shaded_quads_per_object"] = s.cache.shadedQuadsPerObject;
     j["mean_grid_spacing_px"] = {{"along_motion", s.meanSpacingMu}, {"across_motion", s.meanSpacingPerp}};
-    if (s.relMse >= 0) j["rel_mse_vs_reference"] = s.relMse;
-    else j["rel_mse_vs_reference"] = nullptr;
+    if (s.relMse >= 0) {
+        j["rel_mse_vs_reference"] = s.relMse;
+        j["psnr_vs_reference"] = s.psnr;
+    } else {
+        j["rel_mse_vs_reference"] = nullptr;
+    }
     if (s.relMseTruth >= 0) {
         j["rel_mse_vs_truth"] = s.relMseTruth;
         j["truth_seconds"] = s.truthSeconds;
@@ -83,6 +87,7 @@ nlohmann::json sweepJson(const SweepResult& sweep, const std::string& sceneName)
     j["ds"] = statsJson(sweep.ds, sceneName);
     j["aas"] = statsJson(sweep.aas, sceneName);
     j["rel_mse_aas_vs_ds"] = sweep.aasVsDsRelMse;
+    j["psnr_aas_vs_ds"] = sweep.aasVsDsPsnr;
     if (sweep.referenceRelMseTruth >= 0) j["rel_mse_reference_vs_truth"] = sweep.referenceRelMseTruth;
     j["seconds"] = sweep.seconds;
     return j;
