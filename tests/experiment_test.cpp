@@ -81,7 +81,7 @@ TEST(ExperimentSearch, ToleranceStopsEarly) {
 }
 
 TEST(ExperimentCommand, WritesRowsAndASelfContainedReport) {
-    std::string dir = runTinyExperiment("--quiet");
+    std::string dir = runTinyExperiment("--quiet --repeat 2");
     auto rows = nlohmann::json::parse(slurp(dir + "/results.json"));
     ASSERT_TRUE(rows.is_array());
     std::set<std::string> seen;
@@ -92,10 +92,12 @@ TEST(ExperimentCommand, WritesRowsAndASelfContainedReport) {
         EXPECT_TRUE(r["seconds"].contains("sampling"));
         std::string setting = r["setting"];
         seen.insert(r["method"].get<std::string>() + "/" + setting);
-        if (setting == "equal_quality" && r["reached"].get<bool>())
+        if (setting == "equal_quality" && r["reached"].get<bool>()) {
             EXPECT_LE(r["relmse"].get<double>(), r["target_relmse"].get<double>());
-        if (setting == "equal_time" && r["reached"].get<bool>())
+        }
+        if (setting == "equal_time" && r["reached"].get<bool>()) {
             EXPECT_LE(r["seconds"]["total"].get<double>(), r["target_seconds"].get<double>());
+        }
         EXPECT_TRUE(fs::is_regular_file(dir + "/" + r["image"].get<std::string>()));
     }
     // atrous is the anchor here (no aaf/maaf requested): mc gets searched, atrous does not.
@@ -103,7 +105,9 @@ TEST(ExperimentCommand, WritesRowsAndASelfContainedReport) {
     EXPECT_TRUE(seen.count("mc/equal_quality") && seen.count("mc/equal_time"));
     EXPECT_FALSE(seen.count("atrous/equal_quality"));
     for (const auto& r : rows) {
-        if (r["method"] == "atrous") EXPECT_GT(r["seconds"]["filter"].get<double>(), 0.0);
+        if (r["method"] == "atrous") {
+            EXPECT_GT(r["seconds"]["filter"].get<double>(), 0.0);
+        }
         EXPECT_EQ(r["anchor"], "atrous");
     }
 
@@ -160,6 +164,7 @@ TEST(ExperimentCommand, BadInputExitsWithTwo) {
     EXPECT_EQ(test::runWedge(base + "--methods mc --out " + dir + "/missing/parent", nullptr, &err), 2);
     EXPECT_EQ(test::runWedge(base + "--methods mc --reference-spp 2 --out " + dir + "/a", nullptr, &err), 2);
     EXPECT_EQ(test::runWedge(base + "--methods mc --resolution 8by8 --out " + dir + "/a", nullptr, &err), 2);
+    EXPECT_EQ(test::runWedge(base + "--methods mc --repeat 0 --out " + dir + "/a", nullptr, &err), 2);
     EXPECT_EQ(test::runWedge("experiment no-such-scene --quiet --out " + dir + "/a", nullptr, &err), 2);
     EXPECT_EQ(test::runWedge("experiment cornell --quiet", nullptr, &err), 2) << "--out is required";
     EXPECT_FALSE(fs::exists(dir + "/a")) << "nothing is written for bad input";

@@ -86,6 +86,8 @@ void registerExperiment(CLI::App& app) {
         ->check(CLI::NonNegativeNumber);
     cmd->add_option("--tolerance", args->options.tolerance, "Relative spp resolution of the searches")
         ->check(CLI::Range(0.0, 10.0));
+    cmd->add_option("--repeat", args->options.repeat, "Renders per probe; the fastest one's times count (timing noise)")
+        ->check(CLI::Range(1, 20));
     cmd->add_option("--resolution", args->resolution, "Override the camera resolution, WxH");
     cmd->add_option("--seed", args->seed, "Random seed of the methods (default: the scene's render.seed)")
         ->check(CLI::NonNegativeNumber);

@@ -38,6 +38,7 @@ struct ExperimentOptions {
     bool quiet = false;
     int maxSpp = 0;                    // search cap; 0: referenceSpp / 4
     double tolerance = 0.1;            // searches stop when hi <= lo (1 + tolerance) or hi - lo <= 1
+    int repeat = 1;                    // renders per probe; the fastest one's times count
     RenderOptions base;                // method parameters (atrous sigmas, maaf components, ...)
     std::string commandLine;           // shown in the report
 };
@@ -98,7 +99,10 @@ SearchBracket searchBoundary(Above&& above, int start, bool startAbove, double g
     SearchBracket b{0, cap + 1};
     (startAbove ? b.hi : b.lo) = start;
     auto probe = [&](int s) { (above(s) ? b.hi : b.lo) = s; };
-    auto inside = [&](double s) { return std::clamp(int(std::lround(s)), b.lo + 1, b.hi - 1); };
+    auto inside = [&](double s) {
+        if (!(s == s)) s = b.lo + 1;  // NaN
+        return int(std::lround(std::clamp(s, double(b.lo + 1), double(b.hi - 1))));
+    };
     if (b.hi - b.lo > 1) {
         if (startAbove) {
             for (int s = inside(std::min(guess / 1.15, double(start - 1)));; s = std::max(1, s / 2)) {
