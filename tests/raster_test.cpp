@@ -114,7 +114,7 @@ TEST(Raster, AasShadingCostFallsAsBlurGrows) {
     // Motion: the quad (alone) moves sideways, more and more; a cache big enough to hold
     // everything, so that the counts measure the shading rate alone.
     std::vector<uint64_t> aasQuads, dsQuads;
-    for (float v : {0.f, 0.1f, 0.3f, 0.8f}) {
+    for (float v : {0.f, 0.3f, 0.6f, 1.2f}) {
         scene::SceneDesc d = testScene(48, {v, 0, 0}, 0.f, 3.f, false);
         aasQuads.push_back(renderRaster(d, opts(ShadingMode::Adaptive, 1 << 16)).stats.cache.shadedQuads);
         dsQuads.push_back(renderRaster(d, opts(ShadingMode::Decoupled, 1 << 16)).stats.cache.shadedQuads);
@@ -361,6 +361,10 @@ TEST(RasterTexture, BoxFilteredCheckerIsExact) {
     // Half a cell around a cell boundary along x: half light, half dark.
     EXPECT_NEAR(boxFilteredSquareWave(1.f, 0.25f), 0.f, 1e-6f);
     EXPECT_NEAR(boxFilteredSquareWave(0.5f, 0.25f), 1.f, 1e-6f);
+    // The tent of half-width 1 around a cell centre: 3/4 of its weight on the cell, 1/4 outside.
+    EXPECT_NEAR(tentFilteredSquareWave(0.5f, 1.f), 0.5f, 1e-6f);
+    EXPECT_NEAR(tentFilteredSquareWave(1000.5f, 1.f), 0.5f, 1e-5f) << "exact far from the origin";
+    EXPECT_NEAR(tentFilteredSquareWave(0.5f, 1e-5f), 1.f, 1e-6f);
     // Huge footprints go grey, never outside [0, 1].
     float g = filteredChecker({0.1f, 0.2f}, {100, 3}, {-2, 50});
     EXPECT_NEAR(g, 0.5f, 0.05f);
