@@ -72,6 +72,8 @@ void registerRender(CLI::App& app) {
         ->check(CLI::IsMember({3, 5, 7}));
     cmd->add_flag("!--no-focal-fallback", args->options.maafFocalFallback,
                   "maaf: keep all components where the defocus slope changes sign (shows the ringing)");
+    cmd->add_flag("--maaf-windows", args->options.maafWindows,
+                  "maaf: weigh light and lens samples by eq. 20's Gaussian windows (biased for uniform lights)");
     cmd->add_option("--atrous-iterations", args->options.atrousIterations, "atrous: wavelet levels")
         ->check(CLI::Range(1, 10));
     cmd->add_option("--sigma-color", args->options.atrousSigmaColor, "atrous: colour edge-stopping sigma")

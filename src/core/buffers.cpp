@@ -4,7 +4,8 @@ namespace wedge {
 
 FrameBuffers::FrameBuffers(int w, int h)
     : width(w), height(h), color(w, h), emission(w, h), direct(w, h), indirect(w, h), albedo(w, h), normal(w, h),
-      position(w, h), depth(w, h), spp(w, h), object(w, h), variance(w, h), d1(w, h), sMax(w, h), sMin(w, h),
+      position(w, h), offSurface(w, h), depth(w, h), spp(w, h), object(w, h), coverage(w, h), variance(w, h),
+      directUnoccluded(w, h), visibility(w, h), unoccluded(w, h), d1(w, h), sMax(w, h), sMin(w, h),
       occluded(w, h), zMin(w, h), zMax(w, h), suMin(w, h), suMax(w, h), footprint(w, h) {}
 
 void FrameBuffers::forEachPlane(const std::function<void(const std::string&, int, const float*)>& fn) const {
@@ -16,10 +17,15 @@ void FrameBuffers::forEachPlane(const std::function<void(const std::string&, int
     v3("albedo", albedo);
     v3("normal", normal);
     v3("position", position);
+    v3("offsurface", offSurface);
     v1("depth", depth);
     v1("spp", spp);
     v1("object", object);
+    v1("coverage", coverage);
     v1("variance", variance);
+    v3("direct_unoccluded", directUnoccluded);
+    v1("visibility", visibility);
+    v1("unoccluded", unoccluded);
     v1("slope.d1", d1);
     v1("slope.s1", sMax);
     v1("slope.s2", sMin);

@@ -22,8 +22,7 @@ struct SampleRecord {
     Vec3f bounceDir;   // unit bounce direction; zero when no bounce was traced
     Vec2f lens;        // lens position on the unit disc (x along camera right, y along camera up)
     uint32_t light = 0;
-    uint32_t flags = 0;
-    static constexpr uint32_t kHitSurface = 1;
+    float unoccluded = 0;  // luminance of the direct sample without visibility (its weight in visibility filters)
 };
 static_assert(sizeof(SampleRecord) == 64);
 
@@ -37,6 +36,7 @@ struct ViewGeometry {
     struct Light {
         Vec3f center, normal, axisA, axisB;  // axisA/B: orthonormal in the light plane
         float sigma = 1;                     // Gaussian model of the light: sqrt(area)/2
+        float power = 1;                     // luminance of radiance x area
     };
     std::vector<Light> lights;
 
@@ -48,12 +48,21 @@ struct ViewGeometry {
     }
 };
 
-/// Per-pixel planes. Irradiance is demodulated: colour = emission + albedo * (direct + indirect)
-/// holds exactly for the Monte Carlo estimate.
+/// Per-pixel planes. A pixel's samples are split by surface: the G-buffer planes (albedo,
+/// normal, position, depth, object) and the demodulated light (direct, indirect) describe the
+/// samples on the pixel's primary surface (the surface most of its samples hit); `coverage` is
+/// their fraction; `offSurface` is the Monte Carlo colour of all other samples (silhouettes,
+/// defocused edges), which filters pass through unfiltered. For the Monte Carlo estimate
+///   color = emission + coverage * albedo * (direct + indirect) + offSurface
+/// holds exactly.
 struct FrameBuffers {
     int width = 0, height = 0;
-    Image3f color, emission, direct, indirect, albedo, normal, position;
-    Image1f depth, spp, object, variance;  // variance: of the pixel mean's luminance (demodulated light)
+    Image3f color, emission, direct, indirect, albedo, normal, position, offSurface;
+    Image1f depth, spp, object, coverage, variance;  // variance: of the pixel mean's luminance (demodulated light)
+    // Direct light factored as in AAF (report eq. 3.2): direct = directUnoccluded * visibility.
+    Image3f directUnoccluded;  // closed-form unoccluded irradiance / pi of all lights at the primary surface
+    Image1f visibility;        // sum of luminance(direct_s) / sum of unoccluded_s over the primary samples
+    Image1f unoccluded;        // mean unoccluded_s over the primary samples (the visibility's weight)
     // Slope statistics of the initial samples (AAF/MAAF prefilter input).
     Image1f d1;            // mean distance receiver -> light centre over occluded shadow rays
     Image1f sMax, sMin;    // shadow slopes s1 = max d1/d2min - 1, s2 = min d1/d2max - 1; 0/inf when unoccluded
@@ -64,6 +73,11 @@ struct FrameBuffers {
 
     FrameBuffers() = default;
     FrameBuffers(int w, int h);
+
+    /// The final colour from (filtered) demodulated direct and indirect light.
+    Vec3f compose(size_t p, const Vec3f& direct, const Vec3f& indirect) const {
+        return emission[p] + albedo[p] * (direct + indirect) * coverage[p] + offSurface[p];
+    }
 
     /// Every plane with its EXR channel names ("direct.R", "normal.X", "depth", ...).
     void forEachPlane(const std::function<void(const std::string& name, int channels, const float* data)>& fn) const;

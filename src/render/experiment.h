@@ -5,7 +5,10 @@
 // found by bisection over the method's integer --spp inside a bracket that a power-law guess
 // (relMSE ~ 1/spp, time ~ a + b spp) and doubling establish. Writes DIR/results.json (a list of
 // rows), DIR/index.html (self-contained: images as base64 PNG, insets, heat maps, the Fig. 12
-// style table), DIR/table.md and the images under DIR/images/.
+// style table), DIR/table.md and the images under DIR/images/. Times are wall-clock stage times
+// of render(); each probe keeps the fastest of --repeat renders, and the rows of the table are
+// re-timed --repeat more times at the end (the fastest counts), since a shared machine's load
+// comes in bursts.
 //
 // The reference is plain MC at --reference-spp with an independent seed (a hash of the seed), so
 // the methods' errors are not correlated with it; it is cached under the cache directory, keyed
@@ -50,6 +53,7 @@ struct ExperimentProbe {
     StageTimes seconds;
     metrics::Metrics metrics;
     Image3f color;
+    bool retimed = false;  // the final re-timing of the rows has run
 };
 
 struct ExperimentRow {

@@ -1,6 +1,7 @@
 // --method atrous: Monte Carlo sampling exactly as `mc` (ctx.spp samples per pixel), then the
 // edge-avoiding à-trous wavelet filter (filter/atrous.h, Dammertz et al. 2010) over the
-// demodulated direct + indirect light; colour = emission + albedo * filtered light.
+// demodulated direct + indirect light of each pixel's primary surface; colour =
+// FrameBuffers::compose(filtered light) = emission + coverage * albedo * filtered + off-surface samples.
 #include "filter/atrous.h"
 #include "render/methods.h"
 #include "render/sampling.h"
@@ -15,9 +16,9 @@ void renderAtrous(const MethodContext& ctx, RenderResult& result) {
         Timer t;
         result.rays = samplePixels(
             ctx.sampler, stats, view, [&](int, int) { return SampleRange{0, uint32_t(ctx.spp)}; }, false, true,
-            [](int, int, const TracedSample&) {}, &progress);
+            [](int, int, const TracedSample&, int) {}, &progress);
         progress.done();
-        storeStats(stats, view, result.buffers);
+        storeStats(stats, ctx, result.buffers);
         result.seconds.add("sampling", t.seconds());
     }
     filter::AtrousParams params;

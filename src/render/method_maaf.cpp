@@ -1,9 +1,200 @@
-// Placeholder until --method maaf lands; replaced by its implementation.
+// --method maaf: multiple axis-aligned filters (filter/maaf.h) as in Sec. 6.2 of the paper.
+// Stages: initial sampling (16 path samples per pixel with occluder spans, kept as records);
+// prefilter: slopes over a 5x5 window, components per pixel, then the accumulation of eq. 23
+// over each pixel's samples; adaptive sampling only where the wedge degenerates at the focal
+// plane (central filter, AAF rates, at most 100 more samples); filter: eq. 21 on both image
+// axes for direct and indirect light, then multiplied by albedo.
+#include <cmath>
+#include <fstream>
+#include <string>
+#include <unistd.h>
+
 #include "core/error.h"
+#include "core/parallel.h"
+#include "filter/aaf.h"
+#include "filter/maaf.h"
+#include "io/image_io.h"
+#include "render/aov.h"
 #include "render/methods.h"
+#include "render/sampling.h"
 
 namespace wedge::render {
 
-void renderMaaf(const MethodContext&, RenderResult&) { throw Error("--method maaf", "not available yet"); }
+namespace {
+
+/// Memory the machine can still give us, from /proc/meminfo (0 if unknown).
+size_t availableMemory() {
+    std::ifstream in("/proc/meminfo");
+    std::string key;
+    size_t kb = 0;
+    std::string unit;
+    while (in >> key >> kb >> unit)
+        if (key == "MemAvailable:") return kb * 1024;
+    long pages = sysconf(_SC_AVPHYS_PAGES), size = sysconf(_SC_PAGE_SIZE);
+    return pages > 0 && size > 0 ? size_t(pages) * size_t(size) : 0;
+}
+
+}  // namespace
+
+void renderMaaf(const MethodContext& ctx, RenderResult& result) {
+    const ViewGeometry& view = ctx.view;
+    const int W = view.width, H = view.height;
+    const uint32_t n0 = uint32_t(ctx.spp);
+    const int cap = ctx.options.maxExtraSpp >= 0 ? ctx.options.maxExtraSpp : 100;
+    filter::MaafOptions mo;
+    mo.pairs = (ctx.options.maafComponents + 1) / 2;
+    mo.apertureWindows = ctx.options.maafWindows;
+    mo.focalFallback = ctx.options.maafFocalFallback;
+    if (mo.pairs < 1 || mo.pairs > filter::kMaafMaxPairs)
+        throw Error("--maaf-components", "expected 1, 3, 5 or 7 components");
+
+    // Memory: two accumulators (direct, indirect), the initial sample records, per-pixel
+    // parameters. Refuse before allocating more than the machine has.
+    const size_t pixels = size_t(W) * H;
+    const size_t accBytes = filter::MaafAccumulator::bytes(W, H, mo.pairs, 1) + filter::MaafAccumulator::bytes(W, H, mo.pairs, 3);
+    const size_t recordBytes = pixels * n0 * (sizeof(SampleRecord) + 1);
+    const size_t otherBytes = pixels * (2 * sizeof(filter::MaafPixel) + sizeof(PixelStats) +
+                                        size_t(2 * mo.pairs) * 4 * sizeof(float) + 256);
+    const size_t need = accBytes + recordBytes + otherBytes;
+    const size_t avail = availableMemory();
+    if (avail > 0 && need > avail)
+        throw Error("--method maaf", "needs " + std::to_string(need >> 20) + " MiB at " + std::to_string(W) + "x" +
+                                         std::to_string(H) + " with " + std::to_string(2 * mo.pairs - 1) +
+                                         " components and " + std::to_string(n0) + " initial spp, but only " +
+                                         std::to_string(avail >> 20) + " MiB are available");
+    result.extra.emplace_back("maaf_components", double(2 * mo.pairs - 1));
+    result.extra.emplace_back("maaf_accumulator_bytes", double(accBytes));
+    result.extra.emplace_back("maaf_sample_record_bytes", double(recordBytes));
+
+    Image<PixelStats> stats(W, H);
+    FrameBuffers& fb = result.buffers;
+    std::vector<SampleRecord> records(pixels * n0);
+    std::vector<int8_t> slots(pixels * n0, -1);
+
+    // 1. Initial sampling: 16 path samples with occluder spans; keep the records.
+    Timer t;
+    {
+        Progress progress("maaf initial", uint64_t(pixels) * n0, !ctx.options.quiet);
+        std::vector<uint32_t> fill(pixels, 0);
+        result.rays += samplePixels(
+            ctx.sampler, stats, view, [&](int, int) { return SampleRange{0, n0}; }, true, true,
+            [&](int x, int y, const TracedSample& s, int slot) {
+                size_t p = size_t(y) * W + x;
+                size_t i = p * n0 + fill[p]++;
+                records[i] = s.record;
+                slots[i] = int8_t(slot);
+            },
+            &progress);
+    }
+    storeStats(stats, ctx, fb);
+    result.seconds.add("sampling_initial", t.seconds());
+
+    // 2a. Prefilter: slopes over a 5x5 window, frames, components, adaptive counts.
+    t.reset();
+    filter::WedgeOptions wo;
+    wo.radius = 2;
+    wo.fillRadius = mo.maxRadius;  // lit pixels take the wedge of the shadow next to them
+    filter::WedgeField wedges = filter::prefilterWedges(fb, wo);
+    filter::FilterFrames frames = filter::computeFrames(fb, view);
+    filter::MaafParams params = filter::maafParams(fb, wedges, frames, view, mo);
+    filter::AafParams rates = filter::aafParams(fb, wedges, view, filter::AafOptions());
+    Image<uint32_t> extra(W, H);
+    uint64_t extraTotal = 0;
+    for (size_t i = 0; i < pixels; ++i) {
+        if (params.fallback[i] == 0) continue;
+        float need = std::max({rates.sppDirect[i], rates.sppIndirect[i], rates.sppLens[i]});
+        extra[i] = uint32_t(std::clamp(int(std::ceil(need)) - int(n0), 0, cap));
+        extraTotal += extra[i];
+    }
+    result.seconds.add("prefilter_slopes", t.seconds());
+
+    // 2b. Accumulation of eq. 23 over the initial samples on each pixel's primary surface.
+    t.reset();
+    filter::MaafAccumulator accDirect(W, H, mo.pairs, 1), accIndirect(W, H, mo.pairs, 3);
+    std::vector<uint32_t> counted(pixels, 0);
+    auto accumulate = [&](size_t p, const SampleRecord& r) {
+        float y[2], u[2];
+        filter::directCoordinates(r, frames.direct[p], view, y, u);
+        float visibility = r.unoccluded > 0 ? luminance(r.direct) / r.unoccluded : 0.f;  // 0 or 1
+        accDirect.add(p, &visibility, r.unoccluded, y, u, params.direct[p]);
+        filter::indirectCoordinates(r, frames.indirect[p], y, u);
+        accIndirect.add(p, &r.indirect.x, 1.f, y, u, params.indirect[p]);
+        ++counted[p];
+    };
+    parallelRows(H, [&](int y) {
+        for (int x = 0; x < W; ++x) {
+            size_t p = size_t(y) * W + x;
+            int primary = stats[p].primary();
+            for (uint32_t i = 0; i < n0; ++i)
+                if (slots[p * n0 + i] == primary) accumulate(p, records[p * n0 + i]);
+        }
+    });
+    records.clear();
+    records.shrink_to_fit();
+    result.seconds.add("prefilter_accumulation", t.seconds());
+
+    // 3. Adaptive sampling at the focal plane, accumulated as it is traced.
+    t.reset();
+    {
+        Progress progress("maaf adaptive", extraTotal, !ctx.options.quiet && extraTotal > 0);
+        result.rays += samplePixels(
+            ctx.sampler, stats, view, [&](int x, int y) { return SampleRange{n0, extra(x, y)}; }, false, false,
+            [&](int x, int y, const TracedSample& s, int slot) {
+                size_t p = size_t(y) * W + x;
+                if (slot >= 0 && slot == stats[p].primary()) accumulate(p, s.record);
+            },
+            &progress);
+    }
+    storeStats(stats, ctx, fb);
+    result.seconds.add("sampling_adaptive", t.seconds());
+    result.seconds.add("sampling", result.seconds.get("sampling_initial") + result.seconds.get("sampling_adaptive"));
+    result.seconds.add("prefilter",
+                       result.seconds.get("prefilter_slopes") + result.seconds.get("prefilter_accumulation"));
+
+    // 4. Filter (eq. 21 on both axes), direct and indirect separately, then remodulate.
+    t.reset();
+    parallelRows(H, [&](int y) {
+        for (int x = 0; x < W; ++x) {
+            size_t p = size_t(y) * W + x;
+            if (counted[p] > 0) {
+                accDirect.scale(p, 1.f / float(counted[p]));
+                accIndirect.scale(p, 1.f / float(counted[p]));
+            }
+        }
+    });
+    // Direct light as in AAF (report eq. 3.2): filtered visibility x closed-form unoccluded light.
+    Image3f visibility(W, H);
+    for (size_t i = 0; i < pixels; ++i) visibility[i] = Vec3f(fb.visibility[i]);
+    Image3f direct = accDirect.filter(params.direct, fb, frames.direct, visibility, mo);
+    for (size_t i = 0; i < pixels; ++i) direct[i] = fb.directUnoccluded[i] * direct[i].x;
+    Image3f indirect = accIndirect.filter(params.indirect, fb, frames.indirect, fb.indirect, mo);
+    result.color = Image3f(W, H);
+    parallelRows(H, [&](int y) {
+        for (int x = 0; x < W; ++x) {
+            size_t p = size_t(y) * W + x;
+            result.color[p] = fb.compose(p, direct[p], indirect[p]);
+        }
+    });
+    result.seconds.add("filter", t.seconds());
+
+    if (!ctx.options.aovDir.empty()) {
+        const std::string& dir = ctx.options.aovDir;
+        Image1f width(W, H), s2(W, H);
+        for (size_t i = 0; i < pixels; ++i) {
+            width[i] = fb.object[i] < 0 ? 0.f
+                                        : std::min(float(mo.maxRadius),
+                                                   1.f / (params.direct[i].axis[0].sx[0] * frames.direct[i].step[0]));
+            s2[i] = wedges.s2[i] < kInf ? wedges.s2[i] : 0.f;
+        }
+        writeAov(dir, "maaf_central_width_direct", width, 0, float(mo.maxRadius));
+        writeAov(dir, "maaf_fallback", params.fallback, 0, 1);
+        writeAov(dir, "maaf_spp", fb.spp);
+        writeAov(dir, "maaf_s1", wedges.s1);
+        writeAov(dir, "maaf_s2", s2);
+        writeAov(dir, "maaf_defocus_min", wedges.suMin);
+        writeAov(dir, "maaf_defocus_max", wedges.suMax);
+        io::writePng(dir + "/maaf_unfiltered.png", fb.color);
+    }
+}
 
 }  // namespace wedge::render

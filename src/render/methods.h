@@ -22,8 +22,8 @@ void renderAaf(const MethodContext& ctx, RenderResult& result);
 void renderMaaf(const MethodContext& ctx, RenderResult& result);
 void renderAtrous(const MethodContext& ctx, RenderResult& result);
 
-/// Stores every pixel's statistics into `fb`.
-void storeStats(const Image<PixelStats>& stats, const ViewGeometry& view, FrameBuffers& fb);
+/// Stores every pixel's statistics into `fb`, with the closed-form unoccluded direct light.
+void storeStats(const Image<PixelStats>& stats, const MethodContext& ctx, FrameBuffers& fb);
 /// Average samples per pixel of `fb.spp`.
 double averageSpp(const FrameBuffers& fb);
 

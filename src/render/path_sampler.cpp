@@ -22,6 +22,7 @@ ViewGeometry PathSampler::view() const {
         g.axisA = normalize(l.edge1);
         g.axisB = normalize(cross(g.normal, g.axisA));
         g.sigma = l.sigma();
+        g.power = luminance(l.radiance) * l.area();
         v.lights.push_back(g);
     }
     return v;
@@ -69,7 +70,6 @@ TracedSample PathSampler::trace(int x, int y, uint32_t index, bool span) const {
     bool front = dot(hit.normal, ray.direction) < 0;
     Vec3f n = front ? hit.normal : -hit.normal;  // two-sided shading
     out.hit = true;
-    out.record.flags |= SampleRecord::kHitSurface;
     out.albedo = mat.albedo;
     out.normal = n;
     out.position = hit.position;
@@ -83,6 +83,7 @@ TracedSample PathSampler::trace(int x, int y, uint32_t index, bool span) const {
     out.record.light = ls.light;
     out.record.lightPoint = ls.point;
     if (maxComponent(ls.irradiance) > 0) {
+        out.record.unoccluded = luminance(ls.irradiance) * kInvPi;
         Vec3f org = offset(hit.position, n);
         Vec3f toPoint = ls.point - org;
         float dist = length(toPoint);

@@ -2,18 +2,13 @@
 
 namespace wedge::render {
 
-void PixelStats::add(const TracedSample& s, const ViewGeometry& view, bool slopes) {
+void SurfaceSlot::add(const TracedSample& s, const ViewGeometry& view, bool slopes) {
+    if (n == 0) {
+        object = s.object;
+        firstNormal = s.normal;
+    }
     ++n;
     const SampleRecord& r = s.record;
-    Vec3f light = r.direct + r.indirect;
-    color += s.emission + s.albedo * light;
-    float l = luminance(light);
-    lumSum += l;
-    lumSq += l * l;
-    if (!s.hit) return;
-    if (nHit == 0) object = s.object;
-    ++nHit;
-    emission += s.emission;
     albedo += s.albedo;
     rhoDirect += s.albedo * r.direct;
     rhoIndirect += s.albedo * r.indirect;
@@ -22,6 +17,8 @@ void PixelStats::add(const TracedSample& s, const ViewGeometry& view, bool slope
     normal += s.normal;
     position += s.position;
     depth += s.depth;
+    visible += luminance(r.direct);
+    unoccluded += r.unoccluded;
     if (!slopes) return;
     float su = view.defocusSlope(s.depth);
     suMin = std::min(suMin, su);
@@ -45,36 +42,72 @@ void PixelStats::add(const TracedSample& s, const ViewGeometry& view, bool slope
     }
 }
 
+int PixelStats::add(const TracedSample& s, const ViewGeometry& view, bool slopes) {
+    ++n;
+    const SampleRecord& r = s.record;
+    Vec3f l = r.direct + r.indirect;
+    color += s.emission + s.albedo * l;
+    emission += s.emission;
+    light += s.albedo * l;
+    float lum = luminance(l);
+    lumSum += lum;
+    lumSq += lum * lum;
+    if (!s.hit) return -1;
+    for (int k = 0; k < 2; ++k)
+        if (slot[k].n == 0 || slot[k].matches(s)) {
+            slot[k].add(s, view, slopes);
+            return k;
+        }
+    return -1;  // a third surface: only in the colour (offSurface)
+}
+
 void PixelStats::store(FrameBuffers& fb, int x, int y, const ViewGeometry& view) const {
-    float invN = n > 0 ? 1.f / float(n) : 0.f;
-    fb.color(x, y) = color * invN;
-    fb.emission(x, y) = emission * invN;
-    fb.albedo(x, y) = albedo * invN;
-    // Demodulate so that albedo * direct reproduces the estimate of sum(albedo_s * direct_s) / n.
+    const size_t p = size_t(y) * fb.width + x;
+    const float invN = n > 0 ? 1.f / float(n) : 0.f;
+    const SurfaceSlot& m = slot[primary()];
+    fb.color[p] = color * invN;
+    fb.emission[p] = emission * invN;
+    fb.spp[p] = float(n);
+    float mean = lumSum * invN;
+    fb.variance[p] = n > 1 ? std::max(0.f, lumSq * invN - mean * mean) / float(n - 1) : 0.f;
+    if (m.n == 0) {  // nothing hit: background
+        fb.offSurface[p] = light * invN;
+        fb.albedo[p] = fb.direct[p] = fb.indirect[p] = fb.normal[p] = fb.position[p] = Vec3f(0.f);
+        fb.depth[p] = fb.coverage[p] = fb.footprint[p] = fb.visibility[p] = fb.unoccluded[p] = 0;
+        fb.object[p] = -1;
+        fb.d1[p] = fb.sMax[p] = fb.occluded[p] = fb.suMin[p] = fb.suMax[p] = 0;
+        fb.sMin[p] = fb.zMin[p] = fb.zMax[p] = kInf;
+        return;
+    }
+    const float invM = 1.f / float(m.n);
+    Vec3f primaryLight = m.rhoDirect + m.rhoIndirect;
+    fb.offSurface[p] = (light - primaryLight) * invN;
+    fb.coverage[p] = float(m.n) * invN;
+    fb.albedo[p] = m.albedo * invM;
+    // Demodulate so that albedo * direct reproduces the primary surface's mean of albedo_s * direct_s.
     auto demodulate = [&](const Vec3f& rho, const Vec3f& plain) {
         Vec3f out;
-        for (int c = 0; c < 3; ++c) out[c] = albedo[c] > 1e-6f ? rho[c] / albedo[c] : plain[c] * invN;
+        for (int c = 0; c < 3; ++c) out[c] = m.albedo[c] > 1e-6f ? rho[c] / m.albedo[c] : plain[c] * invM;
         return out;
     };
-    fb.direct(x, y) = demodulate(rhoDirect, direct);
-    fb.indirect(x, y) = demodulate(rhoIndirect, indirect);
-    float invHit = nHit > 0 ? 1.f / float(nHit) : 0.f;
-    fb.normal(x, y) = nHit > 0 ? normalize(normal) : Vec3f(0.f);
-    fb.position(x, y) = position * invHit;
-    fb.depth(x, y) = nHit > 0 ? depth * invHit : 0.f;
-    fb.spp(x, y) = float(n);
-    fb.object(x, y) = nHit > 0 ? float(object) : -1.f;
-    float mean = lumSum * invN;
-    fb.variance(x, y) = n > 1 ? std::max(0.f, lumSq * invN - mean * mean) / float(n - 1) : 0.f;
-    fb.d1(x, y) = nOccluded > 0 ? d1Sum / float(nOccluded) : 0.f;
-    fb.sMax(x, y) = nOccluded > 0 ? s1 : 0.f;
-    fb.sMin(x, y) = nOccluded > 0 ? s2 : kInf;
-    fb.occluded(x, y) = nShadow > 0 ? float(nOccluded) / float(nShadow) : 0.f;
-    fb.zMin(x, y) = nBounce > 0 ? zMin : kInf;
-    fb.zMax(x, y) = nBounce > 0 ? zMax : kInf;
-    fb.suMin(x, y) = nHit > 0 && suMin <= suMax ? suMin : 0.f;
-    fb.suMax(x, y) = nHit > 0 && suMin <= suMax ? suMax : 0.f;
-    fb.footprint(x, y) = nHit > 0 ? view.pixelFootprint(fb.depth(x, y)) : 0.f;
+    fb.direct[p] = demodulate(m.rhoDirect, m.direct);
+    fb.indirect[p] = demodulate(m.rhoIndirect, m.indirect);
+    fb.normal[p] = normalize(m.normal);
+    fb.position[p] = m.position * invM;
+    fb.depth[p] = m.depth * invM;
+    fb.object[p] = float(m.object);
+    fb.unoccluded[p] = m.unoccluded * invM;
+    fb.visibility[p] = m.unoccluded > 0 ? m.visible / m.unoccluded : 0.f;
+    fb.footprint[p] = view.pixelFootprint(fb.depth[p]);
+    fb.d1[p] = m.nOccluded > 0 ? m.d1Sum / float(m.nOccluded) : 0.f;
+    fb.sMax[p] = m.nOccluded > 0 ? m.s1 : 0.f;
+    fb.sMin[p] = m.nOccluded > 0 ? m.s2 : kInf;
+    fb.occluded[p] = m.nShadow > 0 ? float(m.nOccluded) / float(m.nShadow) : 0.f;
+    fb.zMin[p] = m.nBounce > 0 ? m.zMin : kInf;
+    fb.zMax[p] = m.nBounce > 0 ? m.zMax : kInf;
+    bool su = m.suMin <= m.suMax;
+    fb.suMin[p] = su ? m.suMin : 0.f;
+    fb.suMax[p] = su ? m.suMax : 0.f;
 }
 
 }  // namespace wedge::render

@@ -1,6 +1,12 @@
 // Per-pixel reduction of path samples into the FrameBuffers planes: the Monte Carlo estimate,
 // the demodulated direct and indirect light, the G-buffer, and the slope statistics of the
 // initial samples (shadow slopes from occluder spans, bounce distances, defocus slopes).
+//
+// Samples are grouped by the surface they hit (object and normal within 20 degrees): the first
+// two surfaces a pixel sees get a slot each; the pixel's primary surface is the slot with more
+// samples. Filters see only the primary surface, so a silhouette pixel (half bar, half floor,
+// or a defocused edge) is never filtered with one surface's neighbours as if it were all one
+// surface; the rest of its samples is kept as an unfiltered colour (FrameBuffers::offSurface).
 #pragma once
 
 #include "core/buffers.h"
@@ -8,19 +14,36 @@
 
 namespace wedge::render {
 
-struct PixelStats {
-    Vec3f color{0.f}, emission{0.f}, albedo{0.f}, rhoDirect{0.f}, rhoIndirect{0.f}, direct{0.f}, indirect{0.f};
-    Vec3f normal{0.f}, position{0.f};
-    float depth = 0, lumSum = 0, lumSq = 0;
-    uint32_t n = 0, nHit = 0, object = 0;
+struct SurfaceSlot {
+    uint32_t n = 0, object = 0;
+    Vec3f firstNormal{0.f};
+    Vec3f albedo{0.f}, rhoDirect{0.f}, rhoIndirect{0.f}, direct{0.f}, indirect{0.f}, normal{0.f}, position{0.f};
+    float depth = 0;
+    float visible = 0, unoccluded = 0;  // sums of luminance(direct_s) and unoccluded_s
     // Slopes (only from samples added with slopes = true).
     float d1Sum = 0;
     uint32_t nShadow = 0, nOccluded = 0, nBounce = 0;
-    float s1 = 0, s2 = kInf;                   // max d1/d2min - 1, min d1/d2max - 1
-    float zMin = kInf, zMax = 0;               // bounce hit distances
-    float suMin = kInf, suMax = -kInf;         // defocus slopes
+    float s1 = 0, s2 = kInf;            // max d1/d2min - 1, min d1/d2max - 1
+    float zMin = kInf, zMax = 0;        // bounce hit distances
+    float suMin = kInf, suMax = -kInf;  // defocus slopes
 
+    bool matches(const TracedSample& s) const {
+        return n > 0 && s.object == object && dot(s.normal, firstNormal) >= 0.9396926f;  // cos 20 degrees
+    }
     void add(const TracedSample& s, const ViewGeometry& view, bool slopes);
+};
+
+struct PixelStats {
+    Vec3f color{0.f}, emission{0.f}, light{0.f};  // light: sum of albedo * (direct + indirect)
+    float lumSum = 0, lumSq = 0;
+    uint32_t n = 0;
+    SurfaceSlot slot[2];
+
+    /// Adds a sample; returns the surface slot it went to (0, 1) or -1 (background or a third surface).
+    int add(const TracedSample& s, const ViewGeometry& view, bool slopes);
+    int primary() const { return slot[1].n > slot[0].n ? 1 : 0; }
+    /// True when the sample lies on the pixel's primary surface (as far as the samples so far tell).
+    bool onPrimary(const TracedSample& s) const { return s.hit && slot[primary()].matches(s); }
     /// Writes this pixel into every plane of `fb`.
     void store(FrameBuffers& fb, int x, int y, const ViewGeometry& view) const;
 };

@@ -4,14 +4,22 @@
 #include "core/parallel.h"
 #include "render/methods.h"
 #include "render/sampling.h"
+#include "scene/light_irradiance.h"
 
 namespace wedge::render {
 
 std::vector<std::string> methods() { return {"mc", "aaf", "maaf", "atrous"}; }
 
-void storeStats(const Image<PixelStats>& stats, const ViewGeometry& view, FrameBuffers& fb) {
+void storeStats(const Image<PixelStats>& stats, const MethodContext& ctx, FrameBuffers& fb) {
+    const auto& lights = ctx.scene.desc().lights;
     parallelRows(stats.height(), [&](int y) {
-        for (int x = 0; x < stats.width(); ++x) stats(x, y).store(fb, x, y, view);
+        for (int x = 0; x < stats.width(); ++x) {
+            stats(x, y).store(fb, x, y, ctx.view);
+            size_t p = size_t(y) * fb.width + x;
+            fb.directUnoccluded[p] =
+                fb.object[p] < 0 ? Vec3f(0.f)
+                                 : scene::unoccludedIrradiance(lights, fb.position[p], fb.normal[p]) * kInvPi;
+        }
     });
 }
 
@@ -28,9 +36,9 @@ void renderMc(const MethodContext& ctx, RenderResult& result) {
     Timer t;
     result.rays = samplePixels(
         ctx.sampler, stats, view, [&](int, int) { return SampleRange{0, uint32_t(ctx.spp)}; }, false, true,
-        [](int, int, const TracedSample&) {}, &progress);
+        [](int, int, const TracedSample&, int) {}, &progress);
     progress.done();
-    storeStats(stats, view, result.buffers);
+    storeStats(stats, ctx, result.buffers);
     result.seconds.add("sampling", t.seconds());
     result.color = result.buffers.color;
 }

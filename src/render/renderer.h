@@ -22,9 +22,10 @@ struct RenderOptions {
     int maxExtraSpp = -1;            // aaf/maaf adaptive cap per pixel; -1 = method default
     int maafComponents = 5;          // 2N-1 filters per 2D/3D subspace
     bool maafFocalFallback = true;   // fall back to the central filter where the defocus slope changes sign
+    bool maafWindows = false;        // eq. 20's Gaussian windows over light and lens samples
     // à-trous
     int atrousIterations = 5;
-    float atrousSigmaColor = 4.f, atrousSigmaNormal = 0.1f, atrousSigmaPosition = 1.f;
+    float atrousSigmaColor = 4.f, atrousSigmaNormal = 0.5f, atrousSigmaPosition = 1.f;
     bool atrousVarianceGuided = true;
     std::string aovDir;              // debug maps (PNG) when non-empty
 };

@@ -17,7 +17,8 @@ struct SampleRange {
     uint32_t first = 0, count = 0;
 };
 
-/// range(x, y) -> SampleRange; sink(x, y, const TracedSample&). Returns the number of rays traced.
+/// range(x, y) -> SampleRange; sink(x, y, const TracedSample&, int slot) with the surface slot
+/// PixelStats::add put the sample in. Returns the number of rays traced.
 template <class RangeFn, class SinkFn>
 uint64_t samplePixels(const PathSampler& sampler, Image<PixelStats>& stats, const ViewGeometry& view, RangeFn&& range,
                       bool span, bool slopes, SinkFn&& sink, Progress* progress) {
@@ -30,8 +31,8 @@ uint64_t samplePixels(const PathSampler& sampler, Image<PixelStats>& stats, cons
                 PixelStats& ps = stats(x, y);
                 for (uint32_t i = 0; i < r.count; ++i) {
                     TracedSample s = sampler.trace(x, y, r.first + i, span);
-                    ps.add(s, view, slopes);
-                    sink(x, y, s);
+                    int slot = ps.add(s, view, slopes);
+                    sink(x, y, s, slot);
                     localRays += s.rays;
                 }
                 localSamples += r.count;

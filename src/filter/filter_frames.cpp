@@ -1,0 +1,70 @@
+#include "filter/filter_frames.h"
+
+#include "core/parallel.h"
+
+namespace wedge::filter {
+
+int dominantLight(const ViewGeometry& view) {
+    int best = 0;
+    for (size_t i = 1; i < view.lights.size(); ++i)
+        if (view.lights[i].power > view.lights[best].power) best = int(i);
+    return best;
+}
+
+namespace {
+
+/// Orthonormal pair from two step vectors (keeps the first direction), with their lengths.
+AxisFrame makeFrame(const Vec3f& s1, const Vec3f& s2, const Vec3f& fallback1, const Vec3f& planeNormal) {
+    AxisFrame f;
+    float l1 = length(s1);
+    Vec3f a1 = l1 > 0 ? s1 / l1 : fallback1;
+    Vec3f t2 = s2 - a1 * dot(a1, s2);
+    float l2 = length(t2);
+    Vec3f a2 = l2 > 1e-12f ? t2 / l2 : normalize(cross(planeNormal, a1));
+    if (dot(a2, s2) < 0) a2 = -a2;
+    f.axis[0] = a1;
+    f.axis[1] = a2;
+    f.step[0] = std::max(l1, 1e-12f);
+    f.step[1] = std::max(std::abs(dot(a2, s2)), 1e-12f);
+    return f;
+}
+
+}  // namespace
+
+FilterFrames computeFrames(const FrameBuffers& fb, const ViewGeometry& view) {
+    FilterFrames ff;
+    ff.direct = Image<AxisFrame>(fb.width, fb.height);
+    ff.indirect = Image<AxisFrame>(fb.width, fb.height);
+    ff.light = dominantLight(view);
+    const Vec3f nl = view.lights.empty() ? Vec3f(0, 1, 0) : view.lights[ff.light].normal;
+    const Vec3f la = view.lights.empty() ? Vec3f(1, 0, 0) : view.lights[ff.light].axisA;
+    const Vec3f down = -view.up;
+    parallelRows(fb.height, [&](int y) {
+        for (int x = 0; x < fb.width; ++x) {
+            size_t p = size_t(y) * fb.width + x;
+            Vec3f n = fb.normal[p];
+            float depth = fb.depth[p];
+            if (fb.object[p] < 0 || depth <= 0) {
+                ff.direct[p] = {{view.right, down}, {1, 1}};
+                ff.indirect[p] = {{view.right, down}, {1, 1}};
+                continue;
+            }
+            // dP/dx for a pinhole ray D = forward + ... (D . forward = 1) hitting the tangent plane:
+            // dP = (depth / f) (e - D (n . e) / (n . D)), e = right or down.
+            Vec3f P = fb.position[p];
+            Vec3f D = (P - view.cameraPosition) / depth;
+            float nD = dot(n, D);
+            float lenD = length(D);
+            if (std::abs(nD) < 0.1f * lenD) nD = std::copysign(0.1f * lenD, nD == 0 ? 1.f : nD);  // grazing: cap the stretch
+            float scale = depth / view.focalPixels;
+            Vec3f s1 = (view.right - D * (dot(n, view.right) / nD)) * scale;
+            Vec3f s2 = (down - D * (dot(n, down) / nD)) * scale;
+            ff.indirect[p] = makeFrame(s1, s2, view.right, n);
+            Vec3f p1 = s1 - nl * dot(nl, s1), p2 = s2 - nl * dot(nl, s2);
+            ff.direct[p] = makeFrame(p1, p2, la, nl);
+        }
+    });
+    return ff;
+}
+
+}  // namespace wedge::filter

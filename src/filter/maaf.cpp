@@ -1,0 +1,313 @@
+#include "filter/maaf.h"
+
+#include <cmath>
+
+#include "core/parallel.h"
+#include "filter/maaf_components.h"
+
+namespace wedge::filter {
+
+namespace {
+
+constexpr float kInvSqrt2Pi = 0.39894228f;
+
+struct AxisInputs {
+    bool yWedge = false;
+    double omegaY = 1, sMin = 1, sMax = 1;  // secondary (light or bounce) wedge
+    bool lens = false;
+    double suMin = 0, suMax = 0;            // lens wedge, world units per lens unit (signed)
+    double omegaU = 6;
+    double step = 1;                        // world size of a pixel along the axis
+    bool fallback = false;
+};
+
+MaafAxis buildAxis(const AxisInputs& in, const MaafOptions& o) {
+    const int pairs = o.pairs, maxRadius = o.maxRadius;
+    MaafAxis ax;
+    const float sxFloor = float(1.0 / (maxRadius * in.step));  // primal std of maxRadius pixels
+    if (!in.yWedge) {
+        // No wedge (no occluder, no bounce hit): the signal is smooth; the widest filter.
+        ax.pairs = 1;
+        ax.sx[0] = sxFloor;
+        ax.weight[0] = 1;
+        return ax;
+    }
+    // Lens wedge, with the sign folded into u (eq. 24 assumes 0 < s^u_min <= s^u_max).
+    double suLo = in.suMin, suHi = in.suMax, uSign = 1;
+    if (in.lens && suHi < 0) {
+        suLo = -in.suMax;
+        suHi = -in.suMin;
+        uSign = -1;
+    }
+    bool straddle = in.lens && suLo < 0;
+    if (straddle) {  // the focal plane crosses the pixel's lens samples: a box in (Omega_x, Omega_u)
+        suHi = std::max(std::abs(suLo), std::abs(suHi));
+        suLo = 0;
+    }
+    // Sec. 6.2: the x bandwidth is the smallest of the pixel's and the two wedges'; tighten Omega_y.
+    double omegaX = o.pixelBandwidth / in.step;
+    omegaX = std::min(omegaX, in.omegaY / in.sMin);
+    if (in.lens && suLo > 0) omegaX = std::min(omegaX, in.omegaU / suLo);
+    WedgeShape w;
+    w.omegaYMax = std::min(in.omegaY, in.sMin * omegaX);
+    w.sMin = in.sMin;
+    w.sMax = std::max(in.sMax, in.sMin);
+    w.lens = in.lens;
+    w.suMin = suLo;
+    w.suMax = suHi;
+    w.omegaUMax = in.omegaU;
+    int n = (in.fallback || straddle) ? 1 : pairs;
+    // The window (maxRadius pixels) resolves Fourier widths down to about 3 / (maxRadius step):
+    // use only as many components as keep the central one that wide (K <= Omega_x R step / 3).
+    if (o.fitComponents) {
+        int kFit = int(std::floor(omegaX * maxRadius * in.step / 3.0));
+        n = std::max(1, std::min(n, (kFit + 1) / 2));
+    }
+    std::vector<MaafComponent> comps = maafComponents(n, w);
+    ax.pairs = n;
+    for (int p = 0; p < n; ++p) {
+        const MaafComponent& c = comps[p];
+        ax.cx[p] = float(c.cx);
+        ax.sx[p] = std::max(float(c.sx) * o.spatialScale, sxFloor);
+        ax.weight[p] = float((p == 0 ? 1.0 : 2.0) * (o.weightsEq10 ? c.mu : 1.0));
+        ax.cy[p] = float(c.cy);
+        ax.cu[p] = in.lens ? float(uSign * c.cu) : 0.f;
+        ax.sy[p] = o.apertureWindows ? float(c.sy) : 0.f;  // 0: no window
+        ax.su[p] = o.apertureWindows && in.lens ? float(c.su) : 0.f;
+    }
+    return ax;
+}
+
+}  // namespace
+
+MaafParams maafParams(const FrameBuffers& fb, const WedgeField& wf, const FilterFrames& frames, const ViewGeometry& view,
+                      const MaafOptions& o) {
+    const int W = fb.width, H = fb.height;
+    MaafParams mp{Image<MaafPixel>(W, H), Image<MaafPixel>(W, H), Image1f(W, H)};
+    float sigma = kInf;
+    for (auto& l : view.lights) sigma = std::min(sigma, l.sigma);
+    const bool lens = view.apertureRadius > 0;
+    parallelRows(H, [&](int y) {
+        for (int x = 0; x < W; ++x) {
+            size_t p = size_t(y) * W + x;
+            if (fb.object[p] < 0) continue;
+            bool fallback = o.focalFallback && lens &&
+                            (wf.focalStraddle[p] > 0 || (wf.suMin[p] < 0 && wf.suMax[p] > 0));
+            mp.fallback[p] = fallback ? 1.f : 0.f;
+            float d = std::max(fb.footprint[p], 1e-12f);
+            for (int k = 0; k < 2; ++k) {
+                AxisInputs in;
+                in.lens = lens;
+                in.omegaU = o.lensOmega;
+                in.fallback = fallback;
+                // Direct: shadow wedge in the light plane.
+                in.step = frames.direct[p].step[k];
+                in.yWedge = wf.s2[p] < kInf;
+                in.omegaY = o.mu / sigma;
+                in.sMin = std::max(wf.s2[p], 1e-4f);
+                in.sMax = std::max(wf.s1[p], wf.s2[p]);
+                in.suMin = wf.suMin[p] * in.step;
+                in.suMax = wf.suMax[p] * in.step;
+                mp.direct[p].axis[k] = buildAxis(in, o);
+                // Indirect: bounce wedge in the tangent plane (z clamped to two pixel sizes).
+                in.step = frames.indirect[p].step[k];
+                in.yWedge = wf.zMin[p] < kInf;
+                in.omegaY = o.indirectOmega;
+                in.sMin = std::max(wf.zMin[p], 2.f * d);
+                in.sMax = std::max(wf.zMax[p], float(in.sMin));
+                in.suMin = wf.suMin[p] * in.step;
+                in.suMax = wf.suMax[p] * in.step;
+                mp.indirect[p].axis[k] = buildAxis(in, o);
+            }
+        }
+    });
+    return mp;
+}
+
+void directCoordinates(const SampleRecord& s, const AxisFrame& frame, const ViewGeometry& view, float y[2], float u[2]) {
+    Vec3f rel = s.lightPoint - view.lights[s.light].center;
+    y[0] = dot(rel, frame.axis[0]);
+    y[1] = dot(rel, frame.axis[1]);
+    u[0] = s.lens.x;
+    u[1] = -s.lens.y;  // lens y is along camera up; axis 2 is image down
+}
+
+void indirectCoordinates(const SampleRecord& s, const AxisFrame& frame, float y[2], float u[2]) {
+    y[0] = dot(s.bounceDir, frame.axis[0]);
+    y[1] = dot(s.bounceDir, frame.axis[1]);
+    u[0] = s.lens.x;
+    u[1] = -s.lens.y;
+}
+
+MaafAccumulator::MaafAccumulator(int width, int height, int pairs, int values)
+    : m_width(width), m_height(height), m_pairs(pairs), m_bands(2 * pairs - 1), m_values(values), m_channels(values + 1),
+      m_stride(size_t(m_bands) * m_bands * m_channels), m_data(size_t(width) * height * m_stride, 0.f) {}
+
+void MaafAccumulator::add(size_t pixel, const float* value, float weight, const float y[2], const float u[2],
+                          const MaafPixel& params) {
+    if (weight == 0.f) return;
+    float A[2][2 * kMaafMaxPairs - 1] = {};
+    for (int k = 0; k < 2; ++k) {
+        const MaafAxis& ax = params.axis[k];
+        for (int p = 0; p < ax.pairs && p < m_pairs; ++p) {
+            // Eq. 23: phase C_y y + C_u u, peak-one windows over the light (bounce) and the lens.
+            float wy = ax.sy[p] * y[k], wu = ax.su[p] * u[k];
+            float win = std::exp(-0.5f * (wy * wy + wu * wu));
+            if (p == 0) {
+                A[k][0] = win;
+            } else {
+                float phi = ax.cy[p] * y[k] + ax.cu[p] * u[k];
+                A[k][2 * p - 1] = win * std::cos(phi);
+                A[k][2 * p] = win * std::sin(phi);
+            }
+        }
+    }
+    float* d = &m_data[pixel * m_stride];
+    const int C = m_channels, V = m_values;
+    for (int i = 0; i < m_bands; ++i) {
+        if (A[0][i] == 0.f) continue;
+        for (int j = 0; j < m_bands; ++j) {
+            float t = A[0][i] * A[1][j] * weight;
+            float* e = d + C * (i * m_bands + j);
+            for (int c = 0; c < V; ++c) e[c] += value[c] * t;
+            e[V] += t;
+        }
+    }
+}
+
+void MaafAccumulator::scale(size_t pixel, float s) {
+    float* d = &m_data[pixel * m_stride];
+    for (size_t i = 0; i < m_stride; ++i) d[i] *= s;
+}
+
+namespace {
+
+/// Radius in pixels of the window along an axis: three standard deviations of the central
+/// component, at most maxRadius.
+int windowRadius(const MaafAxis& ax, float step, int maxRadius) {
+    float stdPx = 1.f / (ax.sx[0] * step);
+    return std::clamp(int(std::ceil(3.f * stdPx)), 1, maxRadius);
+}
+
+/// Neighbour test shared by both passes; on success gives the signed offset a (output minus
+/// input, along `axis` of the output pixel's frame) and the in-plane distance r.
+bool neighbour(const FrameBuffers& fb, const Image<MaafPixel>& params, const AxisFrame& f, size_t p, size_t q, int axis,
+               const MaafOptions& o, float& a, float& r) {
+    if (q != p) {
+        if (!sameSurface(fb, p, q, o.normalCos)) return false;
+        float wp = params[p].axis[axis].sx[0], wq = params[q].axis[axis].sx[0];
+        if (wp > o.bandwidthRatio * wq || wq > o.bandwidthRatio * wp) return false;
+        Vec3f dP = fb.position[p] - fb.position[q];
+        if (std::abs(dot(dP, fb.normal[p])) > o.planeDistance * fb.footprint[p]) return false;
+        float a0 = dot(dP, f.axis[0]), a1 = dot(dP, f.axis[1]);
+        a = axis == 0 ? a0 : a1;
+        r = std::sqrt(a0 * a0 + a1 * a1);
+    } else {
+        a = r = 0;
+    }
+    return true;
+}
+
+}  // namespace
+
+Image3f MaafAccumulator::filter(const Image<MaafPixel>& params, const FrameBuffers& fb, const Image<AxisFrame>& frames,
+                                const Image3f& fallback, const MaafOptions& o) const {
+    const int W = m_width, H = m_height, B = m_bands, C = m_channels, V = m_values;
+    const size_t istride = size_t(B + 1) * C;  // B bands of axis 2, plus the central-only band
+    std::vector<float> inter(size_t(W) * H * istride, 0.f);
+
+    // Pass 1 along image x: sum over the components p of axis 1 (eq. 21).
+    parallelRows(H, [&](int y) {
+        for (int x = 0; x < W; ++x) {
+            size_t p = size_t(y) * W + x;
+            if (fb.object[p] < 0) continue;
+            const MaafAxis& ax = params[p].axis[0];
+            const AxisFrame& f = frames[p];
+            float* out = &inter[p * istride];
+            int radius = windowRadius(ax, f.step[0], o.maxRadius);
+            bool ok[2 * 128 + 1];
+            float av[2 * 128 + 1], rv[2 * 128 + 1];
+            radius = std::min(radius, 128);
+            for (int k = -radius; k <= radius; ++k) {
+                int xx = x + k;
+                ok[k + radius] = xx >= 0 && xx < W &&
+                                 neighbour(fb, params, f, p, size_t(y) * W + xx, 0, o, av[k + radius], rv[k + radius]);
+            }
+            for (int k = -radius; k <= radius; ++k) {
+                if (!ok[k + radius]) continue;
+                // Outer components only where the mirror neighbour exists too: a one-sided window
+                // (an occluder's silhouette next to its shadow) would turn their modulation into bias.
+                bool mirror = !o.symmetricOuter || ok[radius - k];
+                size_t q = size_t(y) * W + x + k;
+                float a = av[k + radius], r = rv[k + radius];
+                const float* T = pixel(q);
+                for (int c = 0; c < (mirror ? ax.pairs : 1); ++c) {
+                    float sr = ax.sx[c] * r;
+                    float g = ax.weight[c] * ax.sx[c] * kInvSqrt2Pi * std::exp(-0.5f * sr * sr);
+                    if (c == 0) {
+                        for (int j = 0; j < B * C; ++j) out[j] += g * T[j];
+                        for (int j = 0; j < C; ++j) out[B * C + j] += g * T[j];
+                    } else {
+                        float gc = g * std::cos(ax.cx[c] * a), gs = g * std::sin(ax.cx[c] * a);
+                        const float* Tc = T + (2 * c - 1) * B * C;
+                        const float* Ts = T + (2 * c) * B * C;
+                        for (int j = 0; j < B * C; ++j) out[j] += gc * Tc[j] + gs * Ts[j];
+                    }
+                }
+            }
+        }
+    });
+
+    // Pass 2 along image y: sum over the components q of axis 2, then the ratio.
+    Image3f result(W, H);
+    parallelRows(H, [&](int y) {
+        for (int x = 0; x < W; ++x) {
+            size_t p = size_t(y) * W + x;
+            if (fb.object[p] < 0) {
+                result[p] = fallback[p];
+                continue;
+            }
+            const MaafAxis& ax = params[p].axis[1];
+            const AxisFrame& f = frames[p];
+            int radius = std::min(windowRadius(ax, f.step[1], o.maxRadius), 128);
+            float h[4] = {0, 0, 0, 0}, h0[4] = {0, 0, 0, 0};  // values..., weight (C <= 4)
+            bool ok[2 * 128 + 1];
+            float av[2 * 128 + 1], rv[2 * 128 + 1];
+            for (int k = -radius; k <= radius; ++k) {
+                int yy = y + k;
+                ok[k + radius] = yy >= 0 && yy < H &&
+                                 neighbour(fb, params, f, p, size_t(yy) * W + x, 1, o, av[k + radius], rv[k + radius]);
+            }
+            for (int k = -radius; k <= radius; ++k) {
+                if (!ok[k + radius]) continue;
+                bool mirror = !o.symmetricOuter || ok[radius - k];
+                size_t q = size_t(y + k) * W + x;
+                float a = av[k + radius], r = rv[k + radius];
+                const float* I = &inter[q * istride];
+                for (int c = 0; c < (mirror ? ax.pairs : 1); ++c) {
+                    float sr = ax.sx[c] * r;
+                    float g = ax.weight[c] * ax.sx[c] * kInvSqrt2Pi * std::exp(-0.5f * sr * sr);
+                    if (c == 0) {
+                        for (int j = 0; j < C; ++j) {
+                            h[j] += g * I[j];
+                            h0[j] += g * I[B * C + j];
+                        }
+                    } else {
+                        float gc = g * std::cos(ax.cx[c] * a), gs = g * std::sin(ax.cx[c] * a);
+                        for (int j = 0; j < C; ++j) h[j] += gc * I[(2 * c - 1) * C + j] + gs * I[(2 * c) * C + j];
+                    }
+                }
+            }
+            // The outer components redistribute energy; if they cancel most of the central
+            // weight (a thin, oddly shaped neighbourhood), the central filter alone is safer.
+            constexpr float thr = 0.25f;
+            const float* r = (h[V] > thr * h0[V] && h[V] > 0) ? h : (h0[V] > 0 ? h0 : nullptr);
+            if (!r) result[p] = fallback[p];
+            else if (V == 1) result[p] = Vec3f(r[0] / r[V]);
+            else result[p] = Vec3f(r[0], r[1], r[2]) / r[V];
+        }
+    });
+    return result;
+}
+
+}  // namespace wedge::filter

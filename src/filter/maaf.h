@@ -1,0 +1,136 @@
+// Multiple axis-aligned filters (Wu et al. 2017) for soft shadows x lens (direct light) and
+// indirect x lens, as 6D filters that are products of two flatland 3D filters, one per image
+// axis (Sec. 6.1 Fig. 7, Sec. 6.2).
+//
+// Per pixel and effect, each axis k has N component pairs p (maaf_components.h: eqs. 6-8, 10 and
+// the corrected eq. 24), built after the Sec. 6.2 optimisation: the x bandwidth is the smallest of
+// the pixel's (1/step), the shadow or indirect wedge's (Omega_y^max / s_min) and the lens
+// wedge's (Omega_u^max / s^u_min), and Omega_y^max is tightened to s_min times it.
+//
+// A sample s at pixel x' with secondary coordinates y_k (light-plane position or bounce
+// direction along axis k) and lens coordinates u_k contributes, per axis and component,
+//   phi = C_y y + C_u u,  window = exp(-(sigma_y y)^2 / 2) exp(-(sigma_u u)^2 / 2)
+// and per pair of components (p on axis 1, q on axis 2) the four products of
+// {cos phi_1, sin phi_1} x {cos phi_2, sin phi_2} (eq. 23 on each axis; the product expands
+// cos(A1 - phi1) cos(A2 - phi2) of the 6D kernel). Only these (2N-1)^2 accumulations are kept
+// per pixel and effect (rgb and the weight alone), never the samples. The image-space filter is
+// eq. 21 on axis 1 (image x), then on axis 2 (image y):
+//   sum_p c_p mu_p g_p(r) [cos(C_x a) T_cos + sin(C_x a) T_sin],  c_0 = 1, c_p = 2,
+// with a = signed world offset (output minus input) along the axis, g_p a unit-integral Gaussian
+// of standard deviation 1/sigma_x^p, neighbours rejected across normal (20 degrees) and depth
+// discontinuities. The result is the ratio of the filtered rgb and the filtered weight, so a
+// constant signal is reproduced exactly.
+//
+// Sign convention (checked numerically in tests/maaf_test.cpp): all three wedges are of the
+// form f(x, y) = g(x + s y) with s > 0 (shadows: x + s y is constant along a ray through an
+// occluder; indirect: x + z y; lens: x + s_u u), whose spectrum lies on Omega_y = s Omega_x.
+// The paper's eq. 19/22 writes cos(C_x (x - x') + C_y y); evaluated as a convolution at y = 0
+// the kernel's argument is -y, so the phase is C_x a - C_y y, which is what is used.
+//
+// Spatial Gaussians are unit-integral, so that component p peaks at mu_p along Omega_x as eq. 9
+// says. Four practical conventions, each measured against a 4096-spp reference (README):
+//  - Fourier widths: the paper's Gaussians have the box half-widths of eq. 8 as standard
+//    deviation, which attenuates the wedge's edge by e^-1/2 and over-blurs; the spatial Fourier
+//    std is sqrt(6) times the half-width, the factor AAF's kernel exp(-3 r^2 Omega^2) implies.
+//  - Windows: eq. 20 weighs light and lens samples by Gaussians of std 1/sigma_y, 1/sigma_u;
+//    for the uniform parallelogram lights and disc apertures here that re-shapes the light and
+//    the bokeh (biased); by default samples are weighted by cos/sin only (eq. 20 without g;
+//    the Monte Carlo density is the light's own profile). `apertureWindows` restores them.
+//  - Components that fit: the central component is K = 2N-1 times wider in space than AAF's
+//    filter; a window of R pixels resolves it only where K <= Omega_x R step / 3, so fewer
+//    components are used where the wedge's bandwidth is low (soft shadows: the axis-aligned
+//    filter, N = 1); truncated wide components are biased next to silhouettes.
+//  - Symmetric support: an outer component's modulated kernel uses a neighbour only if its
+//    mirror is usable too, so a one-sided window (a shadow next to its occluder) does not turn
+//    the modulation into a DC offset.
+//
+// Focal plane (NOTES: the known failure): where the defocus slope changes sign within the
+// detection window the wedge degenerates to a box; those pixels use the central component only
+// (N = 1, the axis-aligned filter) and get adaptive samples at the AAF rates.
+#pragma once
+
+#include <cstddef>
+#include <vector>
+
+#include "core/buffers.h"
+#include "filter/filter_frames.h"
+#include "filter/wedge_field.h"
+
+namespace wedge::filter {
+
+constexpr int kMaafMaxPairs = 4;  // 7 components
+
+struct MaafAxis {
+    int pairs = 1;  // components in use on this axis (1 = central only)
+    float cx[kMaafMaxPairs] = {}, sx[kMaafMaxPairs] = {}, weight[kMaafMaxPairs] = {};  // weight = c_p mu_p
+    float cy[kMaafMaxPairs] = {}, sy[kMaafMaxPairs] = {};
+    float cu[kMaafMaxPairs] = {}, su[kMaafMaxPairs] = {};
+};
+struct MaafPixel {
+    MaafAxis axis[2];
+};
+
+struct MaafOptions {
+    int pairs = 3;               // N: 2N-1 components per axis (--maaf-components 5)
+    float mu = 2.f;              // Omega_y^max = mu / sigma_light (as AAF)
+    float lensOmega = 6.f;       // Omega_u^max, lens = Gaussian of a third of its radius
+    float indirectOmega = 2.8f;  // Omega_h^max of a Lambertian receiver
+    int maxRadius = 10;          // pixels
+    float normalCos = 0.9396926f;
+    float planeDistance = 2.f;   // pixel sizes off the tangent plane
+    float bandwidthRatio = 3.f;  // reject neighbours whose central width differs by more than this factor
+    bool focalFallback = true;
+    // Practical conventions (measured, see the file comment and README):
+    float spatialScale = 2.449490f;  // Fourier std of the spatial Gaussians = sqrt(6) x the half-width (AAF's kernel)
+    float pixelBandwidth = 2.449490f;  // Omega_x never exceeds this / (world size of a pixel)
+    bool apertureWindows = false;    // eq. 20's Gaussian windows over the light and the lens
+    bool weightsEq10 = true;         // mu_p per eq. 10 (false: all components weigh 1)
+    bool fitComponents = true;       // use only as many components as the window resolves
+    bool symmetricOuter = true;      // outer components only where a neighbour's mirror is accepted too
+};
+
+struct MaafParams {
+    Image<MaafPixel> direct, indirect;
+    Image1f fallback;  // 1 where the pixel uses the central component only (focal plane)
+};
+
+/// Components for every pixel, effect and axis.
+MaafParams maafParams(const FrameBuffers& fb, const WedgeField& wedges, const FilterFrames& frames,
+                      const ViewGeometry& view, const MaafOptions& options);
+
+/// Per-pixel accumulations of eq. 23 for one effect, (2N-1)^2 bands x (values..., weight).
+/// Indirect light accumulates rgb with weight 1; direct light accumulates the visible
+/// luminance with the unoccluded luminance as weight, so that the filtered ratio is the
+/// visibility (multiplied afterwards by the closed-form unoccluded irradiance).
+class MaafAccumulator {
+public:
+    MaafAccumulator(int width, int height, int pairs, int values);
+    static size_t bytes(int width, int height, int pairs, int values) {
+        return size_t(width) * height * size_t(sqr(2 * pairs - 1)) * size_t(values + 1) * sizeof(float);
+    }
+    int bands() const { return m_bands; }
+
+    /// Adds one sample: `value` (m_values floats) with weight `weight` (the filter returns the
+    /// weighted mean of the values), secondary coordinates
+    /// y[2] and lens coordinates u[2] (per axis). Not synchronised: one thread per pixel.
+    void add(size_t pixel, const float* value, float weight, const float y[2], const float u[2], const MaafPixel& params);
+    /// Divides a pixel's accumulations by its sample count (per-pixel means).
+    void scale(size_t pixel, float s);
+    const float* pixel(size_t p) const { return &m_data[p * m_stride]; }
+
+    /// Eq. 21 on image x then image y: the filtered values divided by the filtered weight (one
+    /// value channel is replicated to rgb). Pixels without a surface or weight keep `fallback`.
+    Image3f filter(const Image<MaafPixel>& params, const FrameBuffers& fb, const Image<AxisFrame>& frames,
+                   const Image3f& fallback, const MaafOptions& options) const;
+
+private:
+    int m_width, m_height, m_pairs, m_bands, m_values, m_channels;
+    size_t m_stride;
+    std::vector<float> m_data;
+};
+
+/// The secondary and lens coordinates of a sample along a pixel's two axes.
+void directCoordinates(const SampleRecord& s, const AxisFrame& frame, const ViewGeometry& view, float y[2], float u[2]);
+void indirectCoordinates(const SampleRecord& s, const AxisFrame& frame, float y[2], float u[2]);
+
+}  // namespace wedge::filter

@@ -1,0 +1,104 @@
+#include "filter/wedge_field.h"
+
+#include "core/parallel.h"
+
+namespace wedge::filter {
+
+WedgeField prefilterWedges(const FrameBuffers& fb, const WedgeOptions& o) {
+    const int W = fb.width, H = fb.height;
+    WedgeField wf{Image1f(W, H), Image1f(W, H), Image1f(W, H), Image1f(W, H), Image1f(W, H), Image1f(W, H), Image1f(W, H)};
+    parallelRows(H, [&](int y) {
+        for (int x = 0; x < W; ++x) {
+            size_t p = size_t(y) * W + x;
+            float s1 = 0, s2 = kInf, zMin = kInf, zMax = 0, suMin = kInf, suMax = -kInf;
+            bool ownShadow = fb.sMin[p] < kInf, ownBounce = fb.zMin[p] < kInf;
+            for (int dy = -o.radius; dy <= o.radius; ++dy) {
+                int yy = y + dy;
+                if (yy < 0 || yy >= H) continue;
+                for (int dx = -o.radius; dx <= o.radius; ++dx) {
+                    int xx = x + dx;
+                    if (xx < 0 || xx >= W) continue;
+                    size_t q = size_t(yy) * W + xx;
+                    if (q != p && !sameSurface(fb, p, q, o.normalCos)) continue;
+                    if (fb.object[q] < 0) continue;
+                    if (!(o.fillOnly && ownShadow) && fb.sMin[q] < kInf) {
+                        s1 = std::max(s1, fb.sMax[q]);
+                        s2 = std::min(s2, fb.sMin[q]);
+                    }
+                    if (!(o.fillOnly && ownBounce) && fb.zMin[q] < kInf) {
+                        zMin = std::min(zMin, fb.zMin[q]);
+                        zMax = std::max(zMax, fb.zMax[q]);
+                    }
+                    suMin = std::min(suMin, fb.suMin[q]);
+                    suMax = std::max(suMax, fb.suMax[q]);
+                }
+            }
+            if (o.fillOnly && ownShadow) { s1 = fb.sMax[p]; s2 = fb.sMin[p]; }
+            if (o.fillOnly && ownBounce) { zMin = fb.zMin[p]; zMax = fb.zMax[p]; }
+            wf.s1[p] = s1;
+            wf.s2[p] = s2;
+            wf.zMin[p] = zMin;
+            wf.zMax[p] = zMax;
+            wf.suMin[p] = suMin <= suMax ? suMin : 0.f;
+            wf.suMax[p] = suMin <= suMax ? suMax : 0.f;
+        }
+    });
+    // Pixels still without a shadow or bounce wedge (lit, or no bounce hit) take the wedge of the
+    // surface around them, so that every pixel inside a filter's window accumulates with the
+    // same components as the pixel the filter is centred on (MAAF assumes they vary smoothly).
+    if (o.fillRadius > o.radius) {
+        Image1f s1 = wf.s1, s2 = wf.s2, zMin = wf.zMin, zMax = wf.zMax;
+        parallelRows(H, [&](int y) {
+            for (int x = 0; x < W; ++x) {
+                size_t p = size_t(y) * W + x;
+                if (fb.object[p] < 0) continue;
+                bool needShadow = s2[p] >= kInf, needBounce = zMin[p] >= kInf;
+                if (!needShadow && !needBounce) continue;
+                float a1 = 0, a2 = kInf, b1 = kInf, b2 = 0;
+                for (int dy = -o.fillRadius; dy <= o.fillRadius; ++dy) {
+                    int yy = y + dy;
+                    if (yy < 0 || yy >= H) continue;
+                    for (int dx = -o.fillRadius; dx <= o.fillRadius; ++dx) {
+                        int xx = x + dx;
+                        if (xx < 0 || xx >= W) continue;
+                        size_t q = size_t(yy) * W + xx;
+                        if (!sameSurface(fb, p, q, o.normalCos)) continue;
+                        if (s2[q] < kInf) { a1 = std::max(a1, s1[q]); a2 = std::min(a2, s2[q]); }
+                        if (zMin[q] < kInf) { b1 = std::min(b1, zMin[q]); b2 = std::max(b2, zMax[q]); }
+                    }
+                }
+                if (needShadow) { wf.s1[p] = a1; wf.s2[p] = a2; }
+                if (needBounce) { wf.zMin[p] = b1; wf.zMax[p] = b1 < kInf ? b2 : 0.f; }
+            }
+        });
+    }
+
+    // Focal plane: the defocus slope takes both signs within focalRadius (separable min/max).
+    Image1f lo(W, H), hi(W, H);
+    parallelRows(H, [&](int y) {
+        for (int x = 0; x < W; ++x) {
+            float a = kInf, b = -kInf;
+            for (int xx = std::max(0, x - o.focalRadius); xx <= std::min(W - 1, x + o.focalRadius); ++xx) {
+                size_t q = size_t(y) * W + xx;
+                if (fb.object[q] < 0) continue;
+                a = std::min(a, fb.suMin[q]);
+                b = std::max(b, fb.suMax[q]);
+            }
+            lo(x, y) = a;
+            hi(x, y) = b;
+        }
+    });
+    parallelRows(H, [&](int y) {
+        for (int x = 0; x < W; ++x) {
+            float a = kInf, b = -kInf;
+            for (int yy = std::max(0, y - o.focalRadius); yy <= std::min(H - 1, y + o.focalRadius); ++yy) {
+                a = std::min(a, lo(x, yy));
+                b = std::max(b, hi(x, yy));
+            }
+            wf.focalStraddle(x, y) = (a < 0 && b > 0) ? 1.f : 0.f;
+        }
+    });
+    return wf;
+}
+
+}  // namespace wedge::filter
