@@ -73,9 +73,11 @@ void registerExperiment(CLI::App& app) {
     cmd->add_option("--methods", args->options.methods, "Comma-separated methods (default: all; unavailable ones are skipped)")
         ->delimiter(',');
     cmd->add_option("--spp", args->options.spp, "Base samples per pixel of every method (initial spp for aaf/maaf)")
-        ->check(CLI::PositiveNumber);
+        ->check(CLI::PositiveNumber)
+        ->capture_default_str();
     cmd->add_option("--reference-spp", args->options.referenceSpp, "Samples per pixel of the MC reference")
-        ->check(CLI::PositiveNumber);
+        ->check(CLI::PositiveNumber)
+        ->capture_default_str();
     cmd->add_option("--out", args->options.outDir, "Output directory (created if missing)")->required();
     cmd->add_option("--cache", args->options.cacheDir, "Directory of cached references (default: OUT/cache)");
     cmd->add_flag("--equal-time", args->options.equalTime, "Find each method's spp at the anchor's total time");
@@ -86,7 +88,7 @@ void registerExperiment(CLI::App& app) {
         ->check(CLI::NonNegativeNumber);
     cmd->add_option("--tolerance", args->options.tolerance, "Relative spp resolution of the searches")
         ->check(CLI::Range(0.0, 10.0));
-    cmd->add_option("--repeat", args->options.repeat, "Renders per probe; the fastest one's times count (timing noise)")
+    cmd->add_option("--repeat", args->options.repeat, "Renders per probe (and re-timings per row); the fastest counts")
         ->check(CLI::Range(1, 20));
     cmd->add_option("--resolution", args->resolution, "Override the camera resolution, WxH");
     cmd->add_option("--seed", args->seed, "Random seed of the methods (default: the scene's render.seed)")
@@ -95,6 +97,10 @@ void registerExperiment(CLI::App& app) {
     render::RenderOptions& r = args->options.base;
     cmd->add_option("--max-extra-spp", r.maxExtraSpp, "aaf/maaf: cap on adaptive samples per pixel")
         ->check(CLI::NonNegativeNumber);
+    cmd->add_option("--maaf-components", r.maafComponents, "maaf: filters per 2D/3D subspace (3, 5 or 7)")
+        ->check(CLI::IsMember({3, 5, 7}));
+    cmd->add_flag("!--no-focal-fallback", r.maafFocalFallback,
+                  "maaf: keep all components where the defocus slope changes sign");
     cmd->add_option("--atrous-iterations", r.atrousIterations, "atrous: wavelet levels")->check(CLI::Range(1, 10));
     cmd->add_option("--sigma-color", r.atrousSigmaColor, "atrous: colour edge-stopping sigma")->check(CLI::PositiveNumber);
     cmd->add_option("--sigma-normal", r.atrousSigmaNormal, "atrous: normal edge-stopping sigma")->check(CLI::PositiveNumber);
