@@ -157,13 +157,15 @@ TEST(Atrous, EdgeStoppingWeightIsOneForIdenticalPixelsAndInUnitRange) {
     EXPECT_EQ(edgeStoppingWeight(p, q, prm, 1, 0.1f), 0.f);
 }
 
-TEST(Atrous, FrameBuffersGiveEmissionPlusAlbedoTimesFilteredLight) {
+TEST(Atrous, FrameBuffersComposeFilteredLightWithAlbedoCoverageAndOffSurface) {
     FrameBuffers fb(8, 6);
     for (size_t i = 0; i < fb.color.size(); ++i) {
         fb.direct[i] = Vec3f(0.3f, 0.2f, 0.1f);
         fb.indirect[i] = Vec3f(0.1f);
         fb.albedo[i] = Vec3f(float(i % 5) / 5.f);
         fb.emission[i] = Vec3f(i % 7 == 0 ? 2.f : 0.f);
+        fb.coverage[i] = i % 3 == 0 ? 0.5f : 1.f;
+        fb.offSurface[i] = Vec3f(i % 3 == 0 ? 0.25f : 0.f);
         fb.normal[i] = Vec3f(0, 0, 1);
         fb.footprint[i] = 0.01f;
         fb.variance[i] = 0.01f;
@@ -171,7 +173,10 @@ TEST(Atrous, FrameBuffersGiveEmissionPlusAlbedoTimesFilteredLight) {
     Image3f out = atrousFilter(fb, AtrousParams{});
     for (size_t i = 0; i < out.size(); ++i)
         for (int c = 0; c < 3; ++c)
-            ASSERT_NEAR(out[i][c], fb.emission[i][c] + fb.albedo[i][c] * (fb.direct[i][c] + fb.indirect[i][c]), 1e-5f);
+            ASSERT_NEAR(out[i][c],
+                        fb.emission[i][c] + fb.coverage[i] * fb.albedo[i][c] * (fb.direct[i][c] + fb.indirect[i][c]) +
+                            fb.offSurface[i][c],
+                        1e-5f);
 }
 
 TEST(Atrous, RejectsMismatchedPlanesAndBadParameters) {

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <string>
+#include <vector>
 
 #include "core/error.h"
 #include "core/parallel.h"
@@ -11,9 +12,6 @@ namespace wedge::filter {
 namespace {
 
 constexpr float kB3[5] = {1.f / 16, 4.f / 16, 6.f / 16, 4.f / 16, 1.f / 16};  // B3 spline
-constexpr float kVarianceEpsilon = 1e-10f;  // keeps the guided colour weight finite where Var = 0
-
-bool hasHit(const EdgeGuide& g) { return g.footprint > 0; }
 
 /// 3x3 Gaussian (1/16 [1 2 1] x [1 2 1]) of the variance, as SVGF smooths it before use; the
 /// window is cut at the border and renormalised.
@@ -55,92 +53,129 @@ void checkInput(const AtrousInput& in, const AtrousParams& params) {
 
 }  // namespace
 
-float edgeStoppingWeight(const EdgeGuide& p, const EdgeGuide& q, const AtrousParams& params, int step, float colorScale) {
-    if (hasHit(p) != hasHit(q)) return 0.f;
-    float exponent = 0;
-    if (hasHit(p)) {
-        // w_n: normals.
-        exponent += lengthSquared(p.normal - q.normal) / sqr(params.sigmaNormal);
-        // w_x: distance of q from p's tangent plane, in footprints per step width.
-        float plane = dot(p.normal, q.position - p.position);
-        exponent += sqr(plane / (params.sigmaPosition * p.footprint * float(step)));
-    }
-    // w_rt: colour (plain, squared RGB distance) or luminance (variance-guided, SVGF's L1 form).
-    if (params.varianceGuided) exponent += std::abs(p.luminance - q.luminance) / (colorScale + kVarianceEpsilon);
-    else exponent += colorScale > 0 ? lengthSquared(p.color - q.color) / sqr(colorScale) : 0.f;
-    return std::exp(-exponent);
-}
-
 Image3f atrousFilter(const AtrousInput& in, const AtrousParams& params) {
     checkInput(in, params);
     const int w = in.signal.width(), h = in.signal.height();
-    Image3f current = in.signal, next(w, h);
-    Image1f variance = in.variance, nextVariance(w, h);
+    const size_t n = size_t(w) * h;
 
     // Plain mode: the image's noise level (standard deviation of a pixel mean) over hit pixels.
     double varianceSum = 0;
     size_t hits = 0;
-    for (size_t i = 0; i < in.footprint.size(); ++i)
+    for (size_t i = 0; i < n; ++i)
         if (in.footprint[i] > 0) {
             varianceSum += in.variance[i];
             ++hits;
         }
     const float noise0 = hits > 0 ? float(std::sqrt(varianceSum / double(hits))) : 0.f;
 
-    Image1f lum(w, h);
-    auto guideAt = [&](int x, int y) {
-        EdgeGuide g;
-        g.normal = in.normal(x, y);
-        g.position = in.position(x, y);
-        g.footprint = in.footprint(x, y);
-        g.color = current(x, y);
-        g.luminance = lum(x, y);
-        return g;
+    // Planes of structures: the loop over pixels reads each guide component contiguously.
+    struct Planes {
+        std::vector<float> nx, ny, nz, px, py, pz, fp, r, g, b, lum;
+    } pl;
+    for (auto* v : {&pl.nx, &pl.ny, &pl.nz, &pl.px, &pl.py, &pl.pz, &pl.fp, &pl.r, &pl.g, &pl.b, &pl.lum}) v->resize(n);
+    for (size_t i = 0; i < n; ++i) {
+        pl.nx[i] = in.normal[i].x, pl.ny[i] = in.normal[i].y, pl.nz[i] = in.normal[i].z;
+        pl.px[i] = in.position[i].x, pl.py[i] = in.position[i].y, pl.pz[i] = in.position[i].z;
+        pl.fp[i] = in.footprint[i];
+        pl.r[i] = in.signal[i].x, pl.g[i] = in.signal[i].y, pl.b[i] = in.signal[i].z;
+    }
+    std::vector<float> nr(n), ng(n), nb(n), invPlane(n), invLuminance(n), invColor2(n);
+    Image1f variance = in.variance, nextVariance(w, h);
+    auto guideAt = [&pl](size_t i) {
+        EdgeGuide e;
+        e.normal = {pl.nx[i], pl.ny[i], pl.nz[i]};
+        e.position = {pl.px[i], pl.py[i], pl.pz[i]};
+        e.footprint = pl.fp[i];
+        e.luminance = pl.lum[i];
+        e.color = {pl.r[i], pl.g[i], pl.b[i]};
+        return e;
     };
 
     for (int level = 0; level < params.iterations; ++level) {
         const int step = 1 << level;
-        for (size_t i = 0; i < lum.size(); ++i) lum[i] = luminance(current[i]);
         Image1f guideVariance = params.varianceGuided ? blurVariance3x3(variance) : Image1f();
         const float plainScale = params.sigmaColor * noise0 / float(step);
         parallelRows(h, [&](int y) {
-            for (int x = 0; x < w; ++x) {
-                const EdgeGuide p = guideAt(x, y);
-                const float colorScale =
-                    params.varianceGuided ? params.sigmaColor * std::sqrt(guideVariance(x, y)) : plainScale;
-                Vec3f sum(0.f);
-                float weightSum = 0, varianceAcc = 0;
-                for (int j = -2; j <= 2; ++j) {
-                    const int yy = y + j * step;
-                    if (yy < 0 || yy >= h) continue;
-                    for (int i = -2; i <= 2; ++i) {
-                        const int xx = x + i * step;
-                        if (xx < 0 || xx >= w) continue;
-                        const float hw = kB3[i + 2] * kB3[j + 2];
-                        const float wq = (i == 0 && j == 0) ? hw
-                                                            : hw * edgeStoppingWeight(p, guideAt(xx, yy), params, step,
-                                                                                      colorScale);
-                        sum += current(xx, yy) * wq;
-                        weightSum += wq;
-                        if (params.varianceGuided) varianceAcc += wq * wq * variance(xx, yy);
-                    }
-                }
-                // The centre tap always counts, so weightSum > 0.
-                next(x, y) = sum / weightSum;
-                if (params.varianceGuided) nextVariance(x, y) = varianceAcc / (weightSum * weightSum);
+            for (size_t i = size_t(y) * w; i < size_t(y + 1) * w; ++i) {
+                pl.lum[i] = luminance({pl.r[i], pl.g[i], pl.b[i]});
+                EdgeScales s = EdgeScales::at(
+                    guideAt(i), params, step,
+                    params.varianceGuided ? params.sigmaColor * std::sqrt(guideVariance[i]) : plainScale);
+                invPlane[i] = s.invPlane;
+                invLuminance[i] = s.invLuminance;
+                invColor2[i] = s.invColor2;
             }
         });
-        std::swap(current, next);
-        if (params.varianceGuided) std::swap(variance, nextVariance);
+        const float invNormal2 = 1.f / (params.sigmaNormal * params.sigmaNormal);
+        // Raw pointers, so that the compiler sees that the accumulators alias nothing it reads.
+        const float *nx = pl.nx.data(), *ny = pl.ny.data(), *nz = pl.nz.data(), *px = pl.px.data(),
+                    *py = pl.py.data(), *pz = pl.pz.data(), *fp = pl.fp.data(), *lum = pl.lum.data(),
+                    *r = pl.r.data(), *g = pl.g.data(), *b = pl.b.data(), *var = variance.data(),
+                    *ip = invPlane.data(), *il = invLuminance.data(), *ic = invColor2.data();
+        auto guide = [=](size_t i) {
+            EdgeGuide e;
+            e.normal = {nx[i], ny[i], nz[i]};
+            e.position = {px[i], py[i], pz[i]};
+            e.footprint = fp[i];
+            e.luminance = lum[i];
+            e.color = {r[i], g[i], b[i]};
+            return e;
+        };
+        parallelRows(h, [&, guide, invNormal2, ip, il, ic, r, g, b, var](int y) {
+            // Accumulators of one row: sum of h w c (rgb), sum of h w, sum of (h w)^2 Var.
+            std::vector<float> acc(5 * size_t(w), 0.f);
+            float* __restrict sr = acc.data();
+            float* __restrict sg = sr + w;
+            float* __restrict sb = sg + w;
+            float* __restrict sw = sb + w;
+            float* __restrict sv = sw + w;
+            const size_t row = size_t(y) * w;
+            for (int j = -2; j <= 2; ++j) {
+                const int yy = y + j * step;
+                if (yy < 0 || yy >= h) continue;
+                for (int i = -2; i <= 2; ++i) {
+                    const int dx = i * step;
+                    const int x0 = std::max(0, -dx), x1 = std::min(w, w - dx);
+                    const float hw = kB3[i + 2] * kB3[j + 2];
+                    const size_t tapRow = size_t(yy) * w + dx;  // tap of pixel x: tapRow + x
+                    // The accumulators alias none of the planes (the compiler cannot prove it).
+#pragma GCC ivdep
+                    for (int x = x0; x < x1; ++x) {
+                        const size_t p = row + x, q = tapRow + x;
+                        const EdgeScales s{invNormal2, ip[p], il[p], ic[p]};
+                        const float wq = hw * edgeStoppingWeight(guide(p), guide(q), s);
+                        sr[x] += wq * r[q];
+                        sg[x] += wq * g[q];
+                        sb[x] += wq * b[q];
+                        sw[x] += wq;
+                        sv[x] += wq * wq * var[q];
+                    }
+                }
+            }
+            // The centre tap has weight h(0) > 0, so sw > 0.
+            for (int x = 0; x < w; ++x) {
+                const float inv = 1.f / sw[x];
+                nr[row + x] = sr[x] * inv;
+                ng[row + x] = sg[x] * inv;
+                nb[row + x] = sb[x] * inv;
+                nextVariance[row + x] = sv[x] * inv * inv;
+            }
+        });
+        std::swap(pl.r, nr);
+        std::swap(pl.g, ng);
+        std::swap(pl.b, nb);
+        std::swap(variance, nextVariance);
     }
-    return current;
+    Image3f out(w, h);
+    for (size_t i = 0; i < n; ++i) out[i] = {pl.r[i], pl.g[i], pl.b[i]};
+    return out;
 }
 
 Image3f atrousFilter(const FrameBuffers& fb, const AtrousParams& params) {
     Image3f light(fb.width, fb.height);
     for (size_t i = 0; i < light.size(); ++i) light[i] = fb.direct[i] + fb.indirect[i];
     Image3f filtered = atrousFilter(AtrousInput{light, fb.normal, fb.position, fb.footprint, fb.variance}, params);
-    for (size_t i = 0; i < filtered.size(); ++i) filtered[i] = fb.emission[i] + fb.albedo[i] * filtered[i];
+    for (size_t i = 0; i < filtered.size(); ++i) filtered[i] = fb.compose(i, filtered[i], Vec3f(0.f));
     return filtered;
 }
 
