@@ -33,7 +33,7 @@ AafParams aafParams(const FrameBuffers& fb, const WedgeField& wf, const ViewGeom
                                      : 0.f;
 
             // Indirect (report eq. 4.4 with z_min clamped to a few pixel sizes; eq. 4.6 rate).
-            float zMin = std::max(wf.zMin[p], 2.f * d), zMax = std::max(wf.zMax[p], zMin);
+            float zMin = std::max(wf.zMin[p], o.zMinPixels * d), zMax = std::max(wf.zMax[p], zMin);
             bool bounce = wf.zMin[p] < kInf;
             float omegaInd = bounce ? o.indirectOmega / zMin : 0.f;
             float omegaI = std::min({omegaPix, omegaInd, omegaLens});

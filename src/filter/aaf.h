@@ -14,6 +14,7 @@
 // combined Omega_x; a lens rate of the same form as the shadow rate.
 #pragma once
 
+
 #include "core/buffers.h"
 #include "filter/filter_frames.h"
 #include "filter/wedge_field.h"
@@ -28,6 +29,7 @@ struct AafOptions {
     float normalCos = 0.9396926f;  // reject neighbours whose normals differ by 20 degrees or more
     float bandwidthRatio = 3.f;  // reject neighbours whose bandwidth differs by more than this factor
     float planeDistance = 2.f;   // reject neighbours farther than this many pixel sizes off the tangent plane
+    float zMinPixels = 10.f;  // clamp of the bounce distance z_min, in pixel sizes (NOTES: scene-scale constant)
 };
 
 /// Per-pixel AAF parameters.

@@ -113,7 +113,7 @@ MaafParams maafParams(const FrameBuffers& fb, const WedgeField& wf, const Filter
                 in.step = frames.indirect[p].step[k];
                 in.yWedge = wf.zMin[p] < kInf;
                 in.omegaY = o.indirectOmega;
-                in.sMin = std::max(wf.zMin[p], 2.f * d);
+                in.sMin = std::max(wf.zMin[p], o.zMinPixels * d);
                 in.sMax = std::max(wf.zMax[p], float(in.sMin));
                 in.suMin = wf.suMin[p] * in.step;
                 in.suMax = wf.suMax[p] * in.step;

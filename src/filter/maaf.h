@@ -49,6 +49,7 @@
 // (N = 1, the axis-aligned filter) and get adaptive samples at the AAF rates.
 #pragma once
 
+
 #include <cstddef>
 #include <vector>
 
@@ -78,6 +79,7 @@ struct MaafOptions {
     int maxRadius = 10;          // pixels
     float normalCos = 0.9396926f;
     float planeDistance = 2.f;   // pixel sizes off the tangent plane
+    float zMinPixels = 10.f;  // clamp of the bounce distance z_min, in pixel sizes (NOTES: scene-scale constant)
     float bandwidthRatio = 3.f;  // reject neighbours whose central width differs by more than this factor
     bool focalFallback = true;
     // Practical conventions (measured, see the file comment and README):

@@ -6,6 +6,8 @@ void SurfaceSlot::add(const TracedSample& s, const ViewGeometry& view, bool slop
     if (n == 0) {
         object = s.object;
         firstNormal = s.normal;
+        firstPosition = s.position;
+        planeTolerance = 4.f * view.pixelFootprint(s.depth);
     }
     ++n;
     const SampleRecord& r = s.record;

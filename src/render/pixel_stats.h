@@ -16,7 +16,8 @@ namespace wedge::render {
 
 struct SurfaceSlot {
     uint32_t n = 0, object = 0;
-    Vec3f firstNormal{0.f};
+    Vec3f firstNormal{0.f}, firstPosition{0.f};
+    float planeTolerance = 0;  // world distance off the first sample's tangent plane still on this surface
     Vec3f albedo{0.f}, rhoDirect{0.f}, rhoIndirect{0.f}, direct{0.f}, indirect{0.f}, normal{0.f}, position{0.f};
     float depth = 0;
     float visible = 0, unoccluded = 0;  // sums of luminance(direct_s) and unoccluded_s
@@ -27,8 +28,11 @@ struct SurfaceSlot {
     float zMin = kInf, zMax = 0;        // bounce hit distances
     float suMin = kInf, suMax = -kInf;  // defocus slopes
 
+    /// Same surface: same object, normal within 20 degrees, and on the first sample's tangent
+    /// plane (a box face in front of a parallel wall of the same mesh is another surface).
     bool matches(const TracedSample& s) const {
-        return n > 0 && s.object == object && dot(s.normal, firstNormal) >= 0.9396926f;  // cos 20 degrees
+        return n > 0 && s.object == object && dot(s.normal, firstNormal) >= 0.9396926f &&
+               std::abs(dot(s.position - firstPosition, firstNormal)) <= planeTolerance;
     }
     void add(const TracedSample& s, const ViewGeometry& view, bool slopes);
 };

@@ -86,7 +86,10 @@ Scene::Scene(SceneDesc desc) : m_desc(std::move(desc)) {
         unsigned id = rtcAttachGeometry(m_scene, geom);
         rtcReleaseGeometry(geom);  // the scene holds the reference now
         if (m_geometry.size() <= id) m_geometry.resize(id + 1);
-        m_geometry[id] = {mesh.materialIds.data(), 0, object++, false};
+        m_geometry[id] = {mesh.materialIds.data(), mesh.shapeIds.data(), 0, object, false};
+        uint32_t shapes = 0;
+        for (uint32_t sId : mesh.shapeIds) shapes = std::max(shapes, sId + 1);
+        object += std::max(shapes, 1u);
     }
 
     if (!m_desc.spheres.empty()) {
@@ -111,7 +114,8 @@ Scene::Scene(SceneDesc desc) : m_desc(std::move(desc)) {
         rtcReleaseGeometry(geom);
         for (auto& s : m_desc.spheres) m_sphereMaterials.push_back(s.material);
         if (m_geometry.size() <= id) m_geometry.resize(id + 1);
-        m_geometry[id] = {m_sphereMaterials.data(), 0, object++, true};
+        m_geometry[id] = {m_sphereMaterials.data(), nullptr, 0, object, true};
+        object += uint32_t(m_desc.spheres.size());
     }
     rtcCommitScene(m_scene);
     if (rtcGetDeviceError(m_device) != RTC_ERROR_NONE) throw Error("Embree: failed to build the scene");
@@ -137,7 +141,8 @@ bool Scene::intersect(const Vec3f& org, const Vec3f& dir, float tNear, float tFa
     // (tests/scene_test.cpp checks both), which is our front side.
     hit.normal = normalize(ng);
     hit.material = g.materialIds ? g.materialIds[rh.hit.primID] : g.material;
-    hit.object = g.object;
+    // Spheres: one surface each; meshes: one per shape.
+    hit.object = g.object + (g.sphere ? rh.hit.primID : (g.shapeIds ? g.shapeIds[rh.hit.primID] : 0));
     return true;
 }
 

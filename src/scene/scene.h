@@ -18,7 +18,7 @@ struct Hit {
     Vec3f position;
     Vec3f normal;  // unit geometric normal, front side = counter-clockwise winding / sphere outside
     uint32_t material = 0;
-    uint32_t object = 0;  // index into the scene's objects (meshes, then the sphere set)
+    uint32_t object = 0;  // surface id: one per mesh shape (OBJ group) or primitive, one per sphere
 };
 
 /// Nearest and farthest occluder distances along a segment (t measured from its origin).
@@ -49,6 +49,7 @@ public:
 private:
     struct GeometryInfo {
         const uint32_t* materialIds = nullptr;  // per primitive, or null with a constant material
+        const uint32_t* shapeIds = nullptr;     // per primitive: object = object + shapeIds[prim]
         uint32_t material = 0;
         uint32_t object = 0;
         bool sphere = false;

@@ -15,6 +15,7 @@ void appendQuad(TriangleMesh& mesh, const Vec3f& corner, const Vec3f& e1, const 
     mesh.positions.insert(mesh.positions.end(), {corner, corner + e1, corner + e1 + e2, corner + e2});
     mesh.indices.insert(mesh.indices.end(), {base, base + 1, base + 2, base, base + 2, base + 3});
     mesh.materialIds.insert(mesh.materialIds.end(), {material, material});
+    mesh.shapeIds.insert(mesh.shapeIds.end(), {0, 0});
 }
 
 void appendBox(TriangleMesh& mesh, const Vec3f& lo, const Vec3f& hi, uint32_t material) {

@@ -48,6 +48,7 @@ struct TriangleMesh {
     std::vector<Vec3f> positions;
     std::vector<uint32_t> indices;      // 3 per triangle
     std::vector<uint32_t> materialIds;  // 1 per triangle
+    std::vector<uint32_t> shapeIds;     // 1 per triangle: the OBJ group / shape (surfaces the filters keep apart)
     Vec3f velocity{0.f};
     size_t triangleCount() const { return indices.size() / 3; }
 };

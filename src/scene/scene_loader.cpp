@@ -298,7 +298,8 @@ void loadObj(const std::string& path, const std::string& where, int overrideMate
     for (auto& v : mesh.positions)
         if (!isFinite(v)) throw Error(where, "'" + path + "' has a non-finite vertex coordinate");
 
-    for (const auto& shape : shapes) {
+    for (size_t shapeIndex = 0; shapeIndex < shapes.size(); ++shapeIndex) {
+        const auto& shape = shapes[shapeIndex];
         size_t offset = 0;
         for (size_t f = 0; f < shape.mesh.num_face_vertices.size(); ++f) {
             int n = shape.mesh.num_face_vertices[f];
@@ -333,6 +334,7 @@ void loadObj(const std::string& path, const std::string& where, int overrideMate
             for (int k = 1; k + 1 < n; ++k) {  // fan triangulation (OBJ faces are convex)
                 mesh.indices.insert(mesh.indices.end(), {idx[0], idx[k], idx[k + 1]});
                 mesh.materialIds.push_back(matId);
+                mesh.shapeIds.push_back(uint32_t(shapeIndex));
             }
         }
     }
