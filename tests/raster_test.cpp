@@ -210,6 +210,19 @@ TEST(Raster, ImageDoesNotDependOnCacheSizeOrThreadCount) {
     EXPECT_EQ(a.stats.sampleTests, c.stats.sampleTests);
 }
 
+TEST(Raster, DsDoesNotDependOnTheTessellationAasUses) {
+    // Splitting serves AAS's per-primitive bounds; DS keys every sample on the scene's triangle, so
+    // its counts and image stay those of the unsplit scene (up to float rounding at cell borders).
+    scene::SceneDesc d = testScene(48, {0.4f, 0.1f, 0}, 0.08f, 5.f);
+    RasterOptions whole = opts(ShadingMode::Decoupled, 256), split = whole;
+    whole.maxTriangleEdge = 0;
+    split.maxTriangleEdge = 6;
+    RasterResult a = renderRaster(d, whole), b = renderRaster(d, split);
+    EXPECT_GT(b.stats.triangles, 4 * a.stats.triangles);
+    EXPECT_NEAR(double(b.stats.cache.shadedQuads), double(a.stats.cache.shadedQuads), 0.01 * double(a.stats.cache.shadedQuads));
+    EXPECT_LT(relMse(b.image, a.image), 1e-4);
+}
+
 TEST(Raster, NearPlaneCrossingGeometryKeepsItsSamples) {
     // A floor that runs behind the camera crosses the near plane; the same floor cut just in front
     // of the camera does not. The clipped bounds must not lose a sample, and the reference shading

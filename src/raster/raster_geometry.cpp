@@ -74,12 +74,13 @@ void tessellateSphere(const scene::Sphere& s, std::vector<Vec3f>& pos, std::vect
 /// and the shading normal.
 struct SplitVertex {
     Vec3f world, camera, normal;
+    Vec3f parentBary;  // barycentrics in the scene's (unsplit) triangle
 };
 
 SplitVertex midpoint(const SplitVertex& a, const SplitVertex& b, bool smooth) {
     // Camera-space midpoints of the parent's camera-space vertices: a T-vertex lies on its
     // neighbour's edge up to one rounding, so splitting opens no visible cracks.
-    SplitVertex m{(a.world + b.world) * 0.5f, (a.camera + b.camera) * 0.5f, a.normal};
+    SplitVertex m{(a.world + b.world) * 0.5f, (a.camera + b.camera) * 0.5f, a.normal, (a.parentBary + b.parentBary) * 0.5f};
     if (smooth) m.normal = normalize(a.normal + b.normal);
     return m;
 }
@@ -107,8 +108,10 @@ RasterScene::RasterScene(const scene::SceneDesc& desc, const SplitPolicy& policy
     // Recursive midpoint split (4 children), so that the per-primitive bounds of AAS describe a
     // small patch and fewer samples need the near-plane fallback.
     auto add = [&](auto&& self, const SplitVertex* v, const Vec3f& faceNormal, const Vec3f& velocity, uint32_t material,
-                   uint32_t mesh, bool smooth, int depth) -> void {
+                   uint32_t mesh, bool smooth, int depth, uint32_t parent) -> void {
         RasterTriangle t;
+        t.parent = parent;
+        for (int i = 0; i < 3; ++i) t.parentBary[i] = v[i].parentBary;
         t.faceNormalWorld = faceNormal;
         for (int i = 0; i < 3; ++i) {
             t.pWorld[i] = v[i].world;
@@ -159,11 +162,15 @@ RasterScene::RasterScene(const scene::SceneDesc& desc, const SplitPolicy& policy
                 }
             }
         }
+        if (depth == 0) {  // the scene's triangle itself, kept for shading that ignores the split
+            t.parent = parent = uint32_t(parents.size());
+            parents.push_back(t);
+        }
         if (split) {
             SplitVertex m01 = midpoint(v[0], v[1], smooth), m12 = midpoint(v[1], v[2], smooth),
                         m20 = midpoint(v[2], v[0], smooth);
             const SplitVertex children[4][3] = {{v[0], m01, m20}, {m01, v[1], m12}, {m20, m12, v[2]}, {m01, m12, m20}};
-            for (const auto& c : children) self(self, c, faceNormal, velocity, material, mesh, smooth, depth + 1);
+            for (const auto& c : children) self(self, c, faceNormal, velocity, material, mesh, smooth, depth + 1, parent);
             return;
         }
         if (t.nearSafe) {
@@ -192,8 +199,11 @@ RasterScene::RasterScene(const scene::SceneDesc& desc, const SplitPolicy& policy
         }
         faceNormal = normalize(faceNormal);
         SplitVertex v[3];
-        for (int i = 0; i < 3; ++i) v[i] = {pw[i], camera.toCamera(pw[i]), nw ? nw[i] : faceNormal};
-        add(add, v, faceNormal, velocity, material, mesh, nw != nullptr, 0);
+        for (int i = 0; i < 3; ++i) {
+            v[i] = {pw[i], camera.toCamera(pw[i]), nw ? nw[i] : faceNormal, Vec3f(0.f)};
+            v[i].parentBary[i] = 1.f;
+        }
+        add(add, v, faceNormal, velocity, material, mesh, nw != nullptr, 0, 0);
     };
 
     uint32_t meshIndex = 0;

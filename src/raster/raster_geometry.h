@@ -58,6 +58,10 @@ struct RasterTriangle {
     Vec3f faceNormalWorld;  // unit, cross(p1 - p0, p2 - p0)
     uint32_t material = 0;
     uint32_t mesh = 0;
+    // The scene triangle this one was split from (RasterScene::parents) and the barycentrics of
+    // this triangle's vertices in it.
+    uint32_t parent = 0;
+    Vec3f parentBary[3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
 
     // Every vertex stays in front of kNearDepth over the shutter: the bounds below are exact and
     // the canonical pose exists. Otherwise the bounds are the whole screen and each sample of the
@@ -84,6 +88,9 @@ struct RasterTriangle {
         float inv = 1.f / (w0 + w1 + w2);
         return {(w0 * sCanon[0].x + w1 * sCanon[1].x + w2 * sCanon[2].x) * inv,
                 (w0 * sCanon[0].y + w1 * sCanon[1].y + w2 * sCanon[2].y) * inv};
+    }
+    Vec3f toParent(const Vec3f& bary) const {
+        return parentBary[0] * bary.x + parentBary[1] * bary.y + parentBary[2] * bary.z;
     }
     /// Screen-space barycentrics (affine in the canonical image) -> surface barycentrics.
     Vec3f surfaceBarycentrics(const Vec3f& lambda) const {
@@ -114,7 +121,8 @@ struct RasterScene {
     explicit RasterScene(const scene::SceneDesc& desc, const SplitPolicy& split = {});
 
     RasterCamera camera;
-    std::vector<RasterTriangle> triangles;
+    std::vector<RasterTriangle> triangles;  // what is rasterized: the scene's triangles after splitting
+    std::vector<RasterTriangle> parents;    // the scene's triangles before splitting (not rasterized)
     std::vector<scene::Material> materials;
     std::vector<scene::ParallelogramLight> lights;
     size_t culledTriangles = 0;  // degenerate, off screen, or behind the camera for the whole shutter

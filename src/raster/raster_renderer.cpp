@@ -46,7 +46,22 @@ SplitPolicy splitPolicy(const RasterOptions& opt) {
     return p;
 }
 
-/// One scene's visibility and traversal order, shared by every shading mode and cache size.
+/// The keys of one shading mode: per visible sample (in screen traversal order) its
+/// (shading primitive, cell), and the order the cache meets them in.
+struct ModeKeys {
+    std::vector<ShadingGrid> grids;  // per shading primitive
+    std::vector<CellKey> keys;       // aligned with Pipeline::m_screen
+    std::vector<uint32_t> order;     // positions into keys, in traversal order
+    double meanSpacingMu = 1, meanSpacingPerp = 1;
+};
+
+/// One scene's visibility, shared by every shading mode and cache size.
+///
+/// Shading primitives: the rasterized triangles (ids [0, n)) and the scene's unsplit triangles
+/// (ids n + parent). DS keys every sample on its scene triangle, so splitting (which serves AAS's
+/// bounds) changes neither its grid, nor its clamping, nor its traversal. AAS keys a sample on its
+/// split triangle and that triangle's grid, except where that grid is the pixel grid: there it
+/// shades exactly as DS does. A triangle whose scene triangle crosses the near plane keys on itself.
 class Pipeline {
 public:
     Pipeline(const scene::SceneDesc& desc, const RasterOptions& opt) : m_scene(desc, splitPolicy(opt)), m_opt(opt) {
@@ -59,81 +74,106 @@ public:
         }
         m_stages.add("visibility", timer.seconds());
         timer.reset();
-        buildOrder();
+        m_screen.clear();
+        for (uint32_t idx : screenTraversalOrder(m_vis.width, m_vis.height, m_vis.spp))
+            if (m_vis.samples[idx].prim != kNoPrim) m_screen.push_back(idx);
+        m_visibleOf.assign(m_scene.triangles.size(), 0);
+        for (uint32_t idx : m_screen) ++m_visibleOf[m_vis.samples[idx].prim];
+        // Traversal rank of a shading primitive: a scene triangle just before its first split
+        // child, children in scene order, so shading primitives are met in submission order.
+        size_t n = m_scene.triangles.size();
+        m_rank.assign(n + m_scene.parents.size(), 0);
+        std::vector<bool> seen(m_scene.parents.size(), false);
+        for (size_t c = 0; c < n; ++c) {
+            m_rank[c] = uint32_t(2 * c + 1);
+            uint32_t p = m_scene.triangles[c].parent;
+            if (!seen[p]) {
+                seen[p] = true;
+                m_rank[n + p] = uint32_t(2 * c);
+            }
+        }
         m_stages.add("traversal", timer.seconds());
         m_objects = desc.meshes.size() + desc.spheres.size();
     }
 
-    /// Visible samples grouped by triangle in scene order, each group in screen traversal order.
-    void buildOrder() {
-        std::vector<uint32_t> screen = screenTraversalOrder(m_vis.width, m_vis.height, m_vis.spp);
-        std::vector<uint64_t> offset(m_scene.triangles.size() + 1, 0);
-        for (uint32_t idx : screen)
-            if (uint32_t p = m_vis.samples[idx].prim; p != kNoPrim) ++offset[p + 1];
-        for (size_t i = 1; i < offset.size(); ++i) offset[i] += offset[i - 1];
-        m_visibleOf.assign(m_scene.triangles.size(), 0);
-        for (size_t i = 0; i < m_scene.triangles.size(); ++i) m_visibleOf[i] = offset[i + 1] - offset[i];
-        m_order.resize(offset.back());
-        for (uint32_t idx : screen)
-            if (uint32_t p = m_vis.samples[idx].prim; p != kNoPrim) m_order[offset[p]++] = idx;
+    size_t rasterCount() const { return m_scene.triangles.size(); }
+    const RasterTriangle& shadingTriangle(uint32_t id) const {
+        return id < rasterCount() ? m_scene.triangles[id] : m_scene.parents[id - rasterCount()];
     }
+    /// A sample of a triangle without a canonical pose: shaded on its own.
+    bool isFallback(uint32_t id) const { return id < rasterCount() && !m_scene.triangles[id].nearSafe; }
 
-    std::vector<ShadingGrid> grids(ShadingMode mode, double& meanMu, double& meanPerp) const {
-        std::vector<ShadingGrid> g(m_scene.triangles.size(), ShadingGrid::pixel());
+    ModeKeys mapSamples(ShadingMode mode) const {
+        ModeKeys mk;
+        size_t n = rasterCount();
+        mk.grids.assign(n + m_scene.parents.size(), ShadingGrid::pixel());
+        std::vector<bool> ownKey(n, false);  // keyed on the split triangle itself
         double sumMu = 0, sumPerp = 0, weight = 0;
-        for (size_t i = 0; i < g.size(); ++i) {
+        for (size_t i = 0; i < n; ++i) {
+            const RasterTriangle& tri = m_scene.triangles[i];
+            bool parentSafe = m_scene.parents[tri.parent].nearSafe;
+            ownKey[i] = !parentSafe;
             double mu = 1, perp = 1;
-            if (mode == ShadingMode::Adaptive) {
-                AasBounds b = aasBounds(m_scene.triangles[i], m_scene.camera, m_opt.cutoffs);
-                g[i] = ShadingGrid::fromBounds(b);
-                // Below the pixel rate the lattice is free: start it at the triangle's corner so a
-                // small triangle touches as few quads as it can. At the pixel rate keep DS's grid.
-                if (m_opt.alignGrid && (b.anisotropic || b.dPerp < 1.f)) g[i].alignTo(m_scene.triangles[i]);
-                Vec2f a = g[i].stepA(), c = g[i].stepB();
-                mu = std::hypot(a.x, a.y);
-                perp = std::hypot(c.x, c.y);
+            if (mode == ShadingMode::Adaptive && tri.nearSafe) {
+                AasBounds b = aasBounds(tri, m_scene.camera, m_opt.cutoffs);
+                bool pixelRate = !b.anisotropic && b.dPerp >= 1.f;
+                if (!pixelRate) {
+                    ownKey[i] = true;
+                    mk.grids[i] = ShadingGrid::fromBounds(b);
+                    // Below the pixel rate the lattice is free: start it at the triangle's corner
+                    // so that a small triangle touches as few quads as it can.
+                    if (m_opt.alignGrid) mk.grids[i].alignTo(tri);
+                    Vec2f a = mk.grids[i].stepA(), c = mk.grids[i].stepB();
+                    mu = std::hypot(a.x, a.y);
+                    perp = std::hypot(c.x, c.y);
+                }
             }
-            if (!m_scene.triangles[i].nearSafe) continue;
+            if (!tri.nearSafe) continue;
             sumMu += mu * double(m_visibleOf[i]);
             sumPerp += perp * double(m_visibleOf[i]);
             weight += double(m_visibleOf[i]);
         }
-        meanMu = weight > 0 ? sumMu / weight : 1;
-        meanPerp = weight > 0 ? sumPerp / weight : 1;
-        return g;
-    }
+        mk.meanSpacingMu = weight > 0 ? sumMu / weight : 1;
+        mk.meanSpacingPerp = weight > 0 ? sumPerp / weight : 1;
 
-    /// The (primitive, cell) key of every visible sample, aligned with m_order.
-    std::vector<CellKey> mapSamples(const std::vector<ShadingGrid>& grids) const {
-        std::vector<CellKey> keys(m_order.size());
-        tbb::parallel_for(tbb::blocked_range<size_t>(0, m_order.size(), 4096), [&](const tbb::blocked_range<size_t>& r) {
+        mk.keys.resize(m_screen.size());
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, m_screen.size(), 4096), [&](const tbb::blocked_range<size_t>& r) {
             for (size_t i = r.begin(); i < r.end(); ++i) {
-                const VisibilitySample& vs = m_vis.samples[m_order[i]];
+                const VisibilitySample& vs = m_vis.samples[m_screen[i]];
                 const RasterTriangle& tri = m_scene.triangles[vs.prim];
                 if (!tri.nearSafe) {
-                    keys[i] = {vs.prim, 0, 0};
+                    mk.keys[i] = {vs.prim, 0, 0};
                     continue;
                 }
-                Vec2f g = grids[vs.prim].toGrid(tri.canonicalScreen(vs.bary()));
-                keys[i] = {vs.prim, floorToInt(g.x), floorToInt(g.y)};
+                uint32_t id = ownKey[vs.prim] ? vs.prim : uint32_t(n + tri.parent);
+                Vec2f g = mk.grids[id].toGrid(tri.canonicalScreen(vs.bary()));
+                mk.keys[i] = {id, floorToInt(g.x), floorToInt(g.y)};
             }
         });
-        return keys;
+
+        // Counting sort by the rank of the shading primitive; stable, so screen order within.
+        std::vector<uint64_t> offset(m_rank.size() * 2 + 2, 0);
+        for (const CellKey& k : mk.keys) ++offset[m_rank[k.prim] + 1];
+        for (size_t i = 1; i < offset.size(); ++i) offset[i] += offset[i - 1];
+        mk.order.resize(mk.keys.size());
+        for (size_t i = 0; i < mk.keys.size(); ++i) mk.order[offset[m_rank[mk.keys[i].prim]]++] = uint32_t(i);
+        return mk;
     }
 
     /// Runs the cache over the keys in traversal order. With `quads` and `refs` it records the
     /// shaded quads and, per sample index, the quad lane (4 quad + lane) holding its value.
-    CacheCounts simulate(const std::vector<CellKey>& keys, size_t entries, std::vector<QuadRecord>* quads,
+    CacheCounts simulate(const ModeKeys& mk, size_t entries, std::vector<QuadRecord>* quads,
                          std::vector<uint32_t>* refs) const {
         CacheCounts c;
         c.shadedQuadsPerObject.assign(m_objects, 0);
         LruShadingCache cache(entries);
         if (refs) refs->assign(m_vis.samples.size(), kNoRef);
-        for (size_t i = 0; i < keys.size(); ++i) {
-            const CellKey& key = keys[i];
+        for (uint32_t pos : mk.order) {
+            const CellKey& key = mk.keys[pos];
+            uint32_t sample = m_screen[pos];
             ++c.lookups;
-            const RasterTriangle& tri = m_scene.triangles[key.prim];
-            if (!tri.nearSafe) {  // no shading space: shaded on its own
+            const RasterTriangle& tri = shadingTriangle(key.prim);
+            if (isFallback(key.prim)) {  // no shading space: shaded on its own
                 ++c.misses;
                 ++c.shadedQuads;
                 ++c.shadedQuadsPerObject[tri.mesh];
@@ -141,7 +181,7 @@ public:
             }
             if (const uint32_t* payload = cache.lookup(key)) {
                 ++c.hits;
-                if (refs) (*refs)[m_order[i]] = *payload;
+                if (refs) (*refs)[sample] = *payload;
                 continue;
             }
             ++c.misses;
@@ -154,19 +194,19 @@ public:
                 if (lane != missLane)
                     cache.insert({key.prim, 2 * qx + (lane & 1), 2 * qy + (lane >> 1)}, 4 * quad + uint32_t(lane));
             cache.insert(key, 4 * quad + uint32_t(missLane));
-            if (refs) (*refs)[m_order[i]] = 4 * quad + uint32_t(missLane);
+            if (refs) (*refs)[sample] = 4 * quad + uint32_t(missLane);
         }
         c.shaderInvocations = 4 * c.shadedQuads;
         c.evictions = cache.evictions();
         return c;
     }
 
-    uint64_t distinctQuads(const std::vector<CellKey>& keys) const {
+    uint64_t distinctQuads(const ModeKeys& mk) const {
         std::unordered_set<CellKey, CellKeyHash> seen;
-        seen.reserve(keys.size() / 4 + 16);
+        seen.reserve(mk.keys.size() / 4 + 16);
         uint64_t fallback = 0;
-        for (const CellKey& k : keys) {
-            if (!m_scene.triangles[k.prim].nearSafe) {
+        for (const CellKey& k : mk.keys) {
+            if (isFallback(k.prim)) {
                 ++fallback;
                 continue;
             }
@@ -176,11 +216,13 @@ public:
     }
 
     std::vector<Vec3f> shadeQuads(const std::vector<QuadRecord>& quads, const std::vector<ShadingGrid>& grids) const {
+        // A quad's four cell centres, clamped into its shading primitive, shaded at the canonical
+        // pose with the texture filtered over the grid's cell.
         std::vector<Vec3f> values(quads.size() * 4);
         tbb::parallel_for(tbb::blocked_range<size_t>(0, quads.size(), 256), [&](const tbb::blocked_range<size_t>& r) {
             for (size_t q = r.begin(); q < r.end(); ++q) {
                 const QuadRecord& rec = quads[q];
-                const RasterTriangle& tri = m_scene.triangles[rec.prim];
+                const RasterTriangle& tri = shadingTriangle(rec.prim);
                 for (int lane = 0; lane < 4; ++lane) {
                     ShadingPoint sp = cellShadingPoint(tri, grids[rec.prim], 2 * rec.qx + (lane & 1), 2 * rec.qy + (lane >> 1));
                     Vec3f footA, footB;
@@ -231,21 +273,19 @@ public:
     }
 
     /// A decoupled mode at one cache size: counts, image and stats.
-    RasterResult renderDecoupled(ShadingMode mode, size_t entries) {
+    RasterResult renderDecoupled(ShadingMode mode, size_t entries) const {
         RasterResult r;
         StageTimes stages;
         Timer timer;
-        double meanMu = 1, meanPerp = 1;
-        std::vector<ShadingGrid> g = grids(mode, meanMu, meanPerp);
-        std::vector<CellKey> keys = mapSamples(g);
+        ModeKeys mk = mapSamples(mode);
         stages.add("mapping", timer.seconds());
         timer.reset();
         std::vector<QuadRecord> quads;
         std::vector<uint32_t> refs;
-        CacheCounts counts = simulate(keys, entries, &quads, &refs);
+        CacheCounts counts = simulate(mk, entries, &quads, &refs);
         stages.add("cache", timer.seconds());
         timer.reset();
-        std::vector<Vec3f> values = shadeQuads(quads, g);
+        std::vector<Vec3f> values = shadeQuads(quads, mk.grids);
         stages.add("shading", timer.seconds());
         timer.reset();
         r.image = resolve([&](uint32_t idx) {
@@ -254,33 +294,28 @@ public:
         stages.add("resolve", timer.seconds());
         r.stats = baseStats(mode, entries);
         r.stats.cache = counts;
-        r.stats.meanSpacingMu = meanMu;
-        r.stats.meanSpacingPerp = meanPerp;
-        r.stats.quadsUnboundedCache = distinctQuads(keys);
+        r.stats.meanSpacingMu = mk.meanSpacingMu;
+        r.stats.meanSpacingPerp = mk.meanSpacingPerp;
+        r.stats.quadsUnboundedCache = distinctQuads(mk);
         for (auto& [name, s] : stages.stages()) r.stats.stages.add(name, s);
         r.stats.seconds = 0;
         for (auto& [name, s] : r.stats.stages.stages()) r.stats.seconds += s;
         return r;
     }
 
-    RasterResult renderReference() {
+    RasterResult renderReference() const {
         RasterResult r;
         Timer timer;
         r.image = referenceImage();
         r.stats = baseStats(ShadingMode::Reference, 0);
         r.stats.stages.add("shading", timer.seconds());
-        r.stats.cache.lookups = m_order.size();
-        r.stats.cache.shaderInvocations = m_order.size();
-        r.stats.cache.shadedQuads = (m_order.size() + 3) / 4;  // lanes packed four to a quad
+        r.stats.cache.lookups = m_screen.size();
+        r.stats.cache.shaderInvocations = m_screen.size();
+        r.stats.cache.shadedQuads = (m_screen.size() + 3) / 4;  // lanes packed four to a quad
         r.stats.quadsUnboundedCache = r.stats.cache.shadedQuads;
         r.stats.relMse = 0;
         for (auto& [name, s] : r.stats.stages.stages()) r.stats.seconds += s;
         return r;
-    }
-
-    /// Counts only, for the sweep.
-    CacheCounts countOnly(const std::vector<CellKey>& keys, size_t entries) const {
-        return simulate(keys, entries, nullptr, nullptr);
     }
 
     RasterStats baseStats(ShadingMode mode, size_t entries) const {
@@ -310,8 +345,9 @@ private:
     RasterScene m_scene;
     RasterOptions m_opt;
     VisibilityBuffer m_vis;
-    std::vector<uint32_t> m_order;       // visible sample indices in traversal order
-    std::vector<uint64_t> m_visibleOf;   // visible samples per triangle
+    std::vector<uint32_t> m_screen;      // visible sample indices in screen traversal order
+    std::vector<uint32_t> m_rank;        // traversal rank per shading primitive
+    std::vector<uint64_t> m_visibleOf;   // visible samples per rasterized triangle
     StageTimes m_stages;                 // visibility and traversal, shared by every mode
     size_t m_objects = 0;
 };
@@ -417,10 +453,9 @@ SweepResult sweepCache(const scene::SceneDesc& desc, const RasterOptions& option
     for (size_t i = 0; i < cacheSizes.size(); ++i) sweep.rows[i].cacheEntries = cacheSizes[i];
     for (ShadingMode mode : {ShadingMode::Decoupled, ShadingMode::Adaptive}) {
         RasterResult full = pipeline.renderDecoupled(mode, largest);
-        double mu, perp;
-        std::vector<CellKey> keys = pipeline.mapSamples(pipeline.grids(mode, mu, perp));
+        ModeKeys mk = pipeline.mapSamples(mode);
         for (size_t i = 0; i < cacheSizes.size(); ++i) {
-            CacheCounts c = cacheSizes[i] == largest ? full.stats.cache : pipeline.countOnly(keys, cacheSizes[i]);
+            CacheCounts c = cacheSizes[i] == largest ? full.stats.cache : pipeline.simulate(mk, cacheSizes[i], nullptr, nullptr);
             (mode == ShadingMode::Decoupled ? sweep.rows[i].ds : sweep.rows[i].aas) = c;
         }
         (mode == ShadingMode::Decoupled ? sweep.dsImage : sweep.aasImage) = std::move(full.image);
