@@ -150,7 +150,7 @@ TEST(Raster, CacheCountsMatchAHandCountedTinyCase) {
     d.camera.up = {0, 1, 0};
     d.camera.fovY = 90;
     d.camera.width = d.camera.height = 4;
-    d.materials.push_back({"white", Vec3f(0.5f), Vec3f(0.f)});
+    d.materials.push_back({"white", Vec3f(0.5f), Vec3f(0.f), "", 1.f});
     d.lights.push_back({{-1, -1, 3}, {2, 0, 0}, {0, -2, 0}, Vec3f(1.f)});
     scene::TriangleMesh m;
     m.positions = {{-1.5f, -1.5f, 0}, {4, -1.5f, 0}, {-1.5f, 4, 0}};

@@ -23,7 +23,6 @@ struct QuadRecord {
     int32_t qx, qy;
 };
 
-
 void validate(const scene::SceneDesc& desc, const RasterOptions& opt) {
     if (opt.spp <= 0 || opt.spp > 1024) throw Error("--spp " + std::to_string(opt.spp), "expected 1 to 1024 samples per pixel");
     if (opt.cacheEntries == 0 || opt.cacheEntries > (size_t(1) << 30))

@@ -5,16 +5,19 @@
 // per-primitive motion-aligned grid of eqs. 8-9 and Sec. 3.4), against a reference that shades
 // every visibility sample at its own surface point.
 //
-// Pipeline: (1) visibility (visibility.h) resolves every sample's nearest triangle, as a depth
-// pre-pass would. (2) Traversal order: triangles in scene order (meshes, then tessellated spheres,
-// each in file order), and for each triangle its visible samples in screen traversal order (8x8
-// tiles row-major, 2x2 leaf blocks row-major, pixels row-major, samples by index). This is the
-// order a sort-last pipeline with a hierarchical rasterizer meets a primitive's samples. (3) Each
-// sample maps to (primitive, cell) of its triangle's shading grid; the key is looked up in the LRU
-// cache of `cacheEntries` cells (shading_cache.h); a miss shades the 2x2 quad of cells holding the
-// cell (four shader invocations; cell centres clamped into the triangle) and inserts its four
-// cells. (4) The shaded quads are evaluated (in parallel: the shader is a pure function of the
-// key), and every pixel averages its samples' values (box filter; background black).
+// Pipeline: (0) tessellation (raster_geometry.h) splits blurred triangles longer than 32 pixels,
+// so that AAS bounds small patches; DS ignores the split (it keys on the scene's triangles).
+// (1) Visibility (visibility.h) resolves every sample's nearest triangle, as a depth pre-pass
+// would. (2) Each visible sample maps to (shading primitive, cell) of its triangle's shading grid
+// at the canonical pose. (3) Traversal order: shading primitives in scene order (meshes, then
+// tessellated spheres, each in file order; a scene triangle's pieces in split order), and for each
+// its visible samples in screen traversal order (8x8 tiles row-major, 2x2 leaf blocks row-major,
+// pixels row-major, samples by index): the order a sort-last pipeline with a hierarchical
+// rasterizer meets a primitive's samples. (4) Each key is looked up in the LRU cache of
+// `cacheEntries` cells (shading_cache.h); a miss shades the 2x2 quad of cells holding the cell
+// (four shader invocations; cell centres clamped into the triangle) and inserts its four cells.
+// (5) The shaded quads are evaluated (in parallel: the shader is a pure function of the key), and
+// every pixel averages its samples' values (box filter; background black).
 //
 // Because the shader is a pure function of (primitive, cell), the image does not depend on the
 // cache size: the cache decides only how often a cell is shaded. Triangles that cross the near
