@@ -488,6 +488,7 @@ std::string Experiment::markdownTable() const {
     };
     const ExperimentRow* anchor = find(m_result.anchor, "base");
     const ExperimentRow* mcBase = find("mc", "base");
+    if (!m_options.commandLine.empty()) os << "`" << m_options.commandLine << "`\n\n";
     os << "| " << m_result.scene << " " << m_result.width << "x" << m_result.height
        << " | spp | sampling | prefilter | filter | overhead | total | relMSE | PSNR | SSIM | efficiency |";
     if (m_options.equalQuality) os << " EQ spp | EQ total | " << m_result.anchor << " speedup |";
