@@ -165,7 +165,7 @@ TEST(Atrous, FrameBuffersComposeFilteredLightWithAlbedoCoverageAndOffSurface) {
         fb.albedo[i] = Vec3f(float(i % 5) / 5.f);
         fb.emission[i] = Vec3f(i % 7 == 0 ? 2.f : 0.f);
         fb.coverage[i] = i % 3 == 0 ? 0.5f : 1.f;
-        fb.offSurface[i] = Vec3f(i % 3 == 0 ? 0.25f : 0.f);
+        fb.rest[i] = Vec3f(i % 3 == 0 ? 0.25f : 0.f);
         fb.normal[i] = Vec3f(0, 0, 1);
         fb.footprint[i] = 0.01f;
         fb.variance[i] = 0.01f;
@@ -175,7 +175,7 @@ TEST(Atrous, FrameBuffersComposeFilteredLightWithAlbedoCoverageAndOffSurface) {
         for (int c = 0; c < 3; ++c)
             ASSERT_NEAR(out[i][c],
                         fb.emission[i][c] + fb.coverage[i] * fb.albedo[i][c] * (fb.direct[i][c] + fb.indirect[i][c]) +
-                            fb.offSurface[i][c],
+                            fb.rest[i][c],
                         1e-5f);
 }
 

@@ -1,11 +1,14 @@
 #include "core/buffers.h"
 
+#include "core/parallel.h"
+
 namespace wedge {
 
 FrameBuffers::FrameBuffers(int w, int h)
     : width(w), height(h), color(w, h), emission(w, h), direct(w, h), indirect(w, h), albedo(w, h), normal(w, h),
-      position(w, h), offSurface(w, h), depth(w, h), spp(w, h), object(w, h), coverage(w, h), variance(w, h),
-      directUnoccluded(w, h), visibility(w, h), unoccluded(w, h), d1(w, h), sMax(w, h), sMin(w, h),
+      position(w, h), rest(w, h), depth(w, h), spp(w, h), object(w, h), coverage(w, h), variance(w, h),
+      directUnoccluded(w, h), visibility(w, h), unoccluded(w, h), albedo2(w, h), normal2(w, h), position2(w, h),
+      direct2(w, h), indirect2(w, h), directUnoccluded2(w, h), object2(w, h), coverage2(w, h), d1(w, h), sMax(w, h), sMin(w, h),
       occluded(w, h), zMin(w, h), zMax(w, h), suMin(w, h), suMax(w, h), footprint(w, h) {}
 
 void FrameBuffers::forEachPlane(const std::function<void(const std::string&, int, const float*)>& fn) const {
@@ -17,7 +20,7 @@ void FrameBuffers::forEachPlane(const std::function<void(const std::string&, int
     v3("albedo", albedo);
     v3("normal", normal);
     v3("position", position);
-    v3("offsurface", offSurface);
+    v3("rest", rest);
     v1("depth", depth);
     v1("spp", spp);
     v1("object", object);
@@ -26,6 +29,10 @@ void FrameBuffers::forEachPlane(const std::function<void(const std::string&, int
     v3("direct_unoccluded", directUnoccluded);
     v1("visibility", visibility);
     v1("unoccluded", unoccluded);
+    v3("albedo2", albedo2);
+    v3("direct2", direct2);
+    v3("indirect2", indirect2);
+    v1("coverage2", coverage2);
     v1("slope.d1", d1);
     v1("slope.s1", sMax);
     v1("slope.s2", sMin);
@@ -35,6 +42,43 @@ void FrameBuffers::forEachPlane(const std::function<void(const std::string&, int
     v1("slope.sumin", suMin);
     v1("slope.sumax", suMax);
     v1("footprint", footprint);
+}
+
+}  // namespace wedge
+
+namespace wedge {
+
+Image3f FrameBuffers::composeFiltered(const Image3f& directF, const Image3f& indirectF) const {
+    Image3f out(width, height);
+    constexpr float kNormalCos = 0.9396926f;  // 20 degrees, as the filters' surface test
+    parallelRows(height, [&](int y) {
+        for (int x = 0; x < width; ++x) {
+            size_t p = size_t(y) * width + x;
+            Vec3f c = emission[p] + rest[p];
+            if (object[p] >= 0) c += albedo[p] * (directF[p] + indirectF[p]) * coverage[p];
+            if (coverage2[p] > 0) {
+                // Direct light keeps its own samples: next to a silhouette the occluder's contact
+                // shadow changes within a pixel, so a neighbour's visibility is not this point's.
+                Vec3f d2 = direct2[p], i2 = indirect2[p];
+                float best = kInf;
+                for (int dy = -2; dy <= 2; ++dy)
+                    for (int dx = -2; dx <= 2; ++dx) {
+                        int xx = x + dx, yy = y + dy;
+                        if (xx < 0 || yy < 0 || xx >= width || yy >= height) continue;
+                        size_t q = size_t(yy) * width + xx;
+                        if (object[q] != object2[p] || dot(normal[q], normal2[p]) < kNormalCos) continue;
+                        if (std::abs(dot(position[q] - position2[p], normal[q])) > 2.f * footprint[q]) continue;
+                        float dist = float(dx * dx + dy * dy);
+                        if (dist >= best) continue;
+                        best = dist;
+                        i2 = indirectF[q];
+                    }
+                c += albedo2[p] * (d2 + i2) * coverage2[p];
+            }
+            out[p] = c;
+        }
+    });
+    return out;
 }
 
 }  // namespace wedge

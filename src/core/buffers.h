@@ -48,36 +48,46 @@ struct ViewGeometry {
     }
 };
 
-/// Per-pixel planes. A pixel's samples are split by surface: the G-buffer planes (albedo,
-/// normal, position, depth, object) and the demodulated light (direct, indirect) describe the
-/// samples on the pixel's primary surface (the surface most of its samples hit); `coverage` is
-/// their fraction; `offSurface` is the Monte Carlo colour of all other samples (silhouettes,
-/// defocused edges), which filters pass through unfiltered. For the Monte Carlo estimate
-///   color = emission + coverage * albedo * (direct + indirect) + offSurface
-/// holds exactly.
+/// Per-pixel planes. A pixel's samples are split by surface (object, normal within 20 degrees,
+/// tangent plane): the G-buffer planes (albedo, normal, position, depth, object) and the
+/// demodulated light (direct, indirect) describe the samples on the pixel's primary surface (the
+/// one most of its samples hit), `coverage` is their fraction; the `...2` planes describe the
+/// second surface the pixel sees (a silhouette or a defocused edge), `rest` is the Monte Carlo
+/// colour of all other samples. For the Monte Carlo estimate
+///   color = emission + coverage albedo (direct + indirect) + coverage2 albedo2 (direct2 + indirect2) + rest
+/// holds exactly. Filters filter the primary surface; composeFiltered() gives the second surface
+/// the filtered light of a neighbour whose primary surface it is.
 struct FrameBuffers {
     int width = 0, height = 0;
-    Image3f color, emission, direct, indirect, albedo, normal, position, offSurface;
+    Image3f color, emission, direct, indirect, albedo, normal, position, rest;
     Image1f depth, spp, object, coverage, variance;  // variance: of the pixel mean's luminance (demodulated light)
     // Direct light factored as in AAF (report eq. 3.2): direct = directUnoccluded * visibility.
     Image3f directUnoccluded;  // closed-form unoccluded irradiance / pi of all lights at the primary surface
     Image1f visibility;        // sum of luminance(direct_s) / sum of unoccluded_s over the primary samples
     Image1f unoccluded;        // mean unoccluded_s over the primary samples (the visibility's weight)
+    // The second surface (coverage2 = 0 where there is none).
+    Image3f albedo2, normal2, position2, direct2, indirect2, directUnoccluded2;
+    Image1f object2, coverage2;
     // Slope statistics of the initial samples (AAF/MAAF prefilter input).
     Image1f d1;            // mean distance receiver -> light centre over occluded shadow rays
     Image1f sMax, sMin;    // shadow slopes s1 = max d1/d2min - 1, s2 = min d1/d2max - 1; 0/inf when unoccluded
     Image1f occluded;      // fraction of shadow rays that hit an occluder
-    Image1f zMin, zMax;    // bounce hit distances
+    Image1f zMin, zMax;    // bounce distances
     Image1f suMin, suMax;  // defocus slopes, pixels per unit lens coordinate
     Image1f footprint;     // world size of one pixel at the hit
 
     FrameBuffers() = default;
     FrameBuffers(int w, int h);
 
-    /// The final colour from (filtered) demodulated direct and indirect light.
-    Vec3f compose(size_t p, const Vec3f& direct, const Vec3f& indirect) const {
-        return emission[p] + albedo[p] * (direct + indirect) * coverage[p] + offSurface[p];
+    /// Primary-surface light only, second surface and rest as sampled (Monte Carlo).
+    Vec3f compose(size_t p, const Vec3f& directPrimary, const Vec3f& indirectPrimary) const {
+        return emission[p] + albedo[p] * (directPrimary + indirectPrimary) * coverage[p] +
+               albedo2[p] * (direct2[p] + indirect2[p]) * coverage2[p] + rest[p];
     }
+    /// The final image from filtered primary-surface light: each pixel's second surface takes
+    /// the filtered indirect light of the nearest pixel (within 2) whose primary surface it is;
+    /// its direct light stays as sampled.
+    Image3f composeFiltered(const Image3f& direct, const Image3f& indirect) const;
 
     /// Every plane with its EXR channel names ("direct.R", "normal.X", "depth", ...).
     void forEachPlane(const std::function<void(const std::string& name, int channels, const float* data)>& fn) const;

@@ -72,13 +72,7 @@ void renderAaf(const MethodContext& ctx, RenderResult& result) {
     Image3f direct(W, H);
     for (size_t i = 0; i < direct.size(); ++i) direct[i] = fb.directUnoccluded[i] * filteredVisibility[i].x;
     Image3f indirect = filter::aafFilter(fb.indirect, params.omegaIndirect, fb, frames.indirect, ao);
-    result.color = Image3f(W, H);
-    parallelRows(H, [&](int y) {
-        for (int x = 0; x < W; ++x) {
-            size_t p = size_t(y) * W + x;
-            result.color[p] = fb.compose(p, direct[p], indirect[p]);
-        }
-    });
+    result.color = fb.composeFiltered(direct, indirect);
     result.seconds.add("filter", t.seconds());
 
     if (!ctx.options.aovDir.empty()) {

@@ -101,6 +101,8 @@ void renderMaaf(const MethodContext& ctx, RenderResult& result) {
     Image<uint32_t> extra(W, H);
     uint64_t extraTotal = 0;
     for (size_t i = 0; i < pixels; ++i) {
+        // Sec. 6.2: extra samples only where the wedge degenerates at the focal plane, at the
+        // AAF (MYRD14) rates, since there the filter is the central, axis-aligned one.
         if (params.fallback[i] == 0) continue;
         float need = std::max({rates.sppDirect[i], rates.sppIndirect[i], rates.sppLens[i]});
         extra[i] = uint32_t(std::clamp(int(std::ceil(need)) - int(n0), 0, cap));
@@ -168,13 +170,7 @@ void renderMaaf(const MethodContext& ctx, RenderResult& result) {
     Image3f direct = accDirect.filter(params.direct, fb, frames.direct, visibility, mo);
     for (size_t i = 0; i < pixels; ++i) direct[i] = fb.directUnoccluded[i] * direct[i].x;
     Image3f indirect = accIndirect.filter(params.indirect, fb, frames.indirect, fb.indirect, mo);
-    result.color = Image3f(W, H);
-    parallelRows(H, [&](int y) {
-        for (int x = 0; x < W; ++x) {
-            size_t p = size_t(y) * W + x;
-            result.color[p] = fb.compose(p, direct[p], indirect[p]);
-        }
-    });
+    result.color = fb.composeFiltered(direct, indirect);
     result.seconds.add("filter", t.seconds());
 
     if (!ctx.options.aovDir.empty()) {

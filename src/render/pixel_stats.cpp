@@ -60,20 +60,42 @@ int PixelStats::add(const TracedSample& s, const ViewGeometry& view, bool slopes
             slot[k].add(s, view, slopes);
             return k;
         }
-    return -1;  // a third surface: only in the colour (offSurface)
+    return -1;  // a third surface: only in the colour (FrameBuffers::rest)
 }
 
 void PixelStats::store(FrameBuffers& fb, int x, int y, const ViewGeometry& view) const {
     const size_t p = size_t(y) * fb.width + x;
     const float invN = n > 0 ? 1.f / float(n) : 0.f;
     const SurfaceSlot& m = slot[primary()];
+    const SurfaceSlot& m2 = slot[1 - primary()];
     fb.color[p] = color * invN;
     fb.emission[p] = emission * invN;
     fb.spp[p] = float(n);
     float mean = lumSum * invN;
     fb.variance[p] = n > 1 ? std::max(0.f, lumSq * invN - mean * mean) / float(n - 1) : 0.f;
+    Vec3f slotLight = m.rhoDirect + m.rhoIndirect + m2.rhoDirect + m2.rhoIndirect;
+    fb.rest[p] = (light - slotLight) * invN;
+    // Demodulate so that albedo * direct reproduces a slot's mean of albedo_s * direct_s.
+    auto demodulate = [](const SurfaceSlot& s, const Vec3f& rho, const Vec3f& plain) {
+        Vec3f out;
+        for (int c = 0; c < 3; ++c) out[c] = s.albedo[c] > 1e-6f ? rho[c] / s.albedo[c] : plain[c] / float(s.n);
+        return out;
+    };
+    if (m2.n > 0) {
+        const float inv2 = 1.f / float(m2.n);
+        fb.coverage2[p] = float(m2.n) * invN;
+        fb.albedo2[p] = m2.albedo * inv2;
+        fb.direct2[p] = demodulate(m2, m2.rhoDirect, m2.direct);
+        fb.indirect2[p] = demodulate(m2, m2.rhoIndirect, m2.indirect);
+        fb.normal2[p] = normalize(m2.normal);
+        fb.position2[p] = m2.position * inv2;
+        fb.object2[p] = float(m2.object);
+    } else {
+        fb.coverage2[p] = 0;
+        fb.albedo2[p] = fb.direct2[p] = fb.indirect2[p] = fb.normal2[p] = fb.position2[p] = Vec3f(0.f);
+        fb.object2[p] = -1;
+    }
     if (m.n == 0) {  // nothing hit: background
-        fb.offSurface[p] = light * invN;
         fb.albedo[p] = fb.direct[p] = fb.indirect[p] = fb.normal[p] = fb.position[p] = Vec3f(0.f);
         fb.depth[p] = fb.coverage[p] = fb.footprint[p] = fb.visibility[p] = fb.unoccluded[p] = 0;
         fb.object[p] = -1;
@@ -82,18 +104,10 @@ void PixelStats::store(FrameBuffers& fb, int x, int y, const ViewGeometry& view)
         return;
     }
     const float invM = 1.f / float(m.n);
-    Vec3f primaryLight = m.rhoDirect + m.rhoIndirect;
-    fb.offSurface[p] = (light - primaryLight) * invN;
     fb.coverage[p] = float(m.n) * invN;
     fb.albedo[p] = m.albedo * invM;
-    // Demodulate so that albedo * direct reproduces the primary surface's mean of albedo_s * direct_s.
-    auto demodulate = [&](const Vec3f& rho, const Vec3f& plain) {
-        Vec3f out;
-        for (int c = 0; c < 3; ++c) out[c] = m.albedo[c] > 1e-6f ? rho[c] / m.albedo[c] : plain[c] * invM;
-        return out;
-    };
-    fb.direct[p] = demodulate(m.rhoDirect, m.direct);
-    fb.indirect[p] = demodulate(m.rhoIndirect, m.indirect);
+    fb.direct[p] = demodulate(m, m.rhoDirect, m.direct);
+    fb.indirect[p] = demodulate(m, m.rhoIndirect, m.indirect);
     fb.normal[p] = normalize(m.normal);
     fb.position[p] = m.position * invM;
     fb.depth[p] = m.depth * invM;

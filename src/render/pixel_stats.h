@@ -2,11 +2,12 @@
 // the demodulated direct and indirect light, the G-buffer, and the slope statistics of the
 // initial samples (shadow slopes from occluder spans, bounce distances, defocus slopes).
 //
-// Samples are grouped by the surface they hit (object and normal within 20 degrees): the first
-// two surfaces a pixel sees get a slot each; the pixel's primary surface is the slot with more
-// samples. Filters see only the primary surface, so a silhouette pixel (half bar, half floor,
-// or a defocused edge) is never filtered with one surface's neighbours as if it were all one
-// surface; the rest of its samples is kept as an unfiltered colour (FrameBuffers::offSurface).
+// Samples are grouped by the surface they hit (object, normal within 20 degrees, tangent
+// plane): the first two surfaces a pixel sees get a slot each; the pixel's primary surface is
+// the slot with more samples, the other becomes the `...2` planes. Filters see only primary
+// surfaces, so a silhouette pixel (half bar, half floor, or a defocused edge) is never filtered
+// with one surface's neighbours as if it were all one surface; further surfaces and misses are
+// kept as an unfiltered colour (FrameBuffers::rest).
 #pragma once
 
 #include "core/buffers.h"
