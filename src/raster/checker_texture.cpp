@@ -1,3 +1,6 @@
+// The band-limited checker texture: closed-form box and tent filters of the square wave and the
+// anisotropic tap layout over a shading cell's footprint (see checker_texture.h; the footprint is
+// the AAS shading cell of Vaidyanathan et al. 2012, Sec. 3.4, or one pixel for DS).
 #include "raster/checker_texture.h"
 
 namespace wedge::raster {

@@ -1,3 +1,5 @@
+// Unshadowed diffuse shading: Lambert's polygon irradiance for each parallelogram light, clipped
+// to the receiver's hemisphere, times the filtered albedo (see diffuse_shader.h).
 #include "raster/diffuse_shader.h"
 
 #include "raster/checker_texture.h"

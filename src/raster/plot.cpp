@@ -1,3 +1,5 @@
+// The sweep plot's renderer: log axes, anti-aliased segments and discs by distance coverage, and a
+// built-in 5x7 bitmap font (see plot.h).
 #include "raster/plot.h"
 
 #include <cstdio>

@@ -1,3 +1,6 @@
+// Scene description -> rasterizable triangles: camera-space setup, exact conservative bounds over
+// the shutter and lens, the canonical pose of Vaidyanathan et al. 2012 (eq. 4), sphere
+// tessellation, near-plane clipping, and the blur-driven midpoint split (see raster_geometry.h).
 #include "raster/raster_geometry.h"
 
 namespace wedge::raster {

@@ -1,3 +1,6 @@
+// The pipeline of raster_renderer.h: shared visibility, per-mode keys (DS pixel grid or AAS grid of
+// eqs. 8-9), the LRU cache simulation in traversal order, quad shading, resolve, reference, truth
+// and the cache-size sweep.
 #include "raster/raster_renderer.h"
 
 #include <unordered_set>

@@ -1,3 +1,4 @@
+// JSON stats, the sweep's CSV and JSON, and its plot (Vaidyanathan et al. 2012, Fig. 8).
 #include "raster/raster_report.h"
 
 #include <cstdio>

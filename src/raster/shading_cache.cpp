@@ -1,3 +1,5 @@
+// The LRU memoization cache of decoupled sampling: a hash map into a fixed pool of nodes on an
+// intrusive recency list (see shading_cache.h).
 #include "raster/shading_cache.h"
 
 #include "core/error.h"

@@ -1,3 +1,6 @@
+// AAS frequency bounds (Vaidyanathan et al. 2012, Sec. 3.2, eqs. 7-9), the grid mapping M_g
+// (Sec. 3.4), the clamp of shading points into the triangle (Ericson 2005), and the world-space
+// texture footprint of a grid cell (see shading_space.h).
 #include "raster/shading_space.h"
 
 namespace wedge::raster {

@@ -1,3 +1,5 @@
+// The stochastic rasterizer of visibility.h: tile binning, per-tile sample buckets by time slab and
+// lens region, lens intervals per triangle and slab, the thin-lens ray test and the depth test.
 #include "raster/visibility.h"
 
 #include <algorithm>
