@@ -161,7 +161,7 @@ void registerRaster(CLI::App& app) {
         ->check(CLI::PositiveNumber)
         ->capture_default_str();
     cmd->add_option("--split-edge", args->splitEdge,
-                    "Split triangles longer than this on the canonical image (pixels; 0: never)")
+                    "Split blurred triangles longer than this on the canonical image (pixels; 0: never)")
         ->check(CLI::NonNegativeNumber)
         ->capture_default_str();
     cmd->add_flag("--no-grid-align", args->noGridAlign,
