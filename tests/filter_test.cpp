@@ -1,0 +1,263 @@
+// Filter module (AAF and MAAF) on synthetic buffers: invariants of the image-space filters, the
+// separable MAAF path against a direct evaluation of the 6D kernel (eq. 22), and the component
+// construction (N = 1 is AAF's filter, eq. 2; the lens axis follows the wedge geometry).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+
+#include "core/parallel.h"
+#include "core/sampler.h"
+#include "filter/aaf.h"
+#include "filter/maaf.h"
+#include "filter/maaf_components.h"
+
+using namespace wedge;
+using namespace wedge::filter;
+
+namespace {
+
+/// A planar surface seen straight on: pixel (x, y) at world (x, y, 0), normal +z, unit steps.
+struct Plane {
+    FrameBuffers fb;
+    Image<AxisFrame> frames;
+    Plane(int w, int h) : fb(w, h), frames(w, h) {
+        for (int y = 0; y < h; ++y)
+            for (int x = 0; x < w; ++x) {
+                size_t i = size_t(y) * w + x;
+                fb.object[i] = 0;
+                fb.normal[i] = {0, 0, 1};
+                fb.position[i] = {x + 0.5f, y + 0.5f, 0};
+                fb.footprint[i] = 1;
+                fb.coverage[i] = 1;
+                frames[i].axis[0] = {1, 0, 0};
+                frames[i].axis[1] = {0, 1, 0};
+                frames[i].step[0] = frames[i].step[1] = 1;
+            }
+    }
+};
+
+float rnd(uint32_t i) { return float(hash32(i) >> 8) * 0x1p-24f; }
+
+}  // namespace
+
+TEST(AafFilter, ConstantImageStaysConstant) {
+    Plane pl(32, 24);
+    Image3f signal(32, 24, Vec3f(0.3f, 0.5f, 0.7f));
+    Image1f omega(32, 24), weight(32, 24);
+    for (size_t i = 0; i < omega.size(); ++i) {
+        omega[i] = 0.05f + rnd(uint32_t(i)) * 0.5f;  // spatially varying widths
+        weight[i] = 0.1f + rnd(uint32_t(i) + 999);
+    }
+    for (const Image1f* w : {(const Image1f*)nullptr, (const Image1f*)&weight}) {
+        Image3f out = aafFilter(signal, omega, pl.fb, pl.frames, AafOptions(), w);
+        for (size_t i = 0; i < out.size(); ++i)
+            for (int c = 0; c < 3; ++c) ASSERT_NEAR(out[i][c], signal[i][c], 1e-5f);
+    }
+}
+
+TEST(AafFilter, ZeroWidthIsIdentity) {
+    Plane pl(16, 16);
+    Image3f signal(16, 16);
+    for (size_t i = 0; i < signal.size(); ++i) signal[i] = Vec3f(rnd(uint32_t(i)), rnd(uint32_t(i) + 7), 1.f);
+    Image1f omega(16, 16, 1e3f);  // bandwidth far above a pixel: radius 0
+    Image3f out = aafFilter(signal, omega, pl.fb, pl.frames, AafOptions());
+    for (size_t i = 0; i < out.size(); ++i) EXPECT_EQ(out[i], signal[i]);
+}
+
+TEST(AafFilter, NoNanWithoutSamples) {
+    Plane pl(16, 16);
+    Image3f signal(16, 16, Vec3f(1.f));
+    Image1f omega(16, 16, 0.1f), weight(16, 16, 0.f);  // no pixel saw unoccluded light
+    for (int i = 0; i < 16; ++i) pl.fb.object[i * 17] = -1;  // and some saw nothing at all
+    Image3f out = aafFilter(signal, omega, pl.fb, pl.frames, AafOptions(), &weight);
+    for (size_t i = 0; i < out.size(); ++i) EXPECT_TRUE(isFinite(out[i]));
+}
+
+TEST(AafFilter, KeepsEdgesAcrossNormalDiscontinuities) {
+    Plane pl(20, 8);
+    Image3f signal(20, 8);
+    for (int y = 0; y < 8; ++y)
+        for (int x = 0; x < 20; ++x) {
+            bool right = x >= 10;
+            pl.fb.normal(x, y) = right ? normalize(Vec3f(0.5f, 0, 1)) : Vec3f(0, 0, 1);  // 26.6 degrees apart
+            signal(x, y) = Vec3f(right ? 1.f : 0.f);
+        }
+    Image1f omega(20, 8, 0.f);  // widest filter
+    Image3f out = aafFilter(signal, omega, pl.fb, pl.frames, AafOptions());
+    for (int y = 0; y < 8; ++y)
+        for (int x = 0; x < 20; ++x) EXPECT_EQ(out(x, y).x, signal(x, y).x) << x;
+}
+
+TEST(AafFilter, SameResultOnOneAndTwoThreads) {
+    Plane pl(40, 30);
+    Image3f signal(40, 30);
+    Image1f omega(40, 30);
+    for (size_t i = 0; i < signal.size(); ++i) {
+        signal[i] = Vec3f(rnd(uint32_t(i)));
+        omega[i] = 0.1f + 0.2f * rnd(uint32_t(i) + 5);
+    }
+    Image3f a, b;
+    {
+        ThreadLimit one(1);
+        a = aafFilter(signal, omega, pl.fb, pl.frames, AafOptions());
+    }
+    {
+        ThreadLimit two(2);
+        b = aafFilter(signal, omega, pl.fb, pl.frames, AafOptions());
+    }
+    EXPECT_EQ(0, std::memcmp(a.data(), b.data(), a.size() * sizeof(Vec3f)));
+}
+
+TEST(MaafComponents, OneComponentIsTheAxisAlignedFilterOfEq2) {
+    WedgeShape w;
+    w.omegaYMax = 4;
+    w.sMin = 0.5;
+    w.sMax = 2;
+    auto c = maafComponents(1, w);
+    ASSERT_EQ(c.size(), 1u);
+    EXPECT_EQ(c[0].cx, 0);
+    EXPECT_EQ(c[0].cy, 0);
+    EXPECT_DOUBLE_EQ(c[0].sx, 4 / 0.5);  // G(Omega_x; Omega_y^max / s_min)
+    EXPECT_DOUBLE_EQ(c[0].sy, 4);        // G(Omega_y; Omega_y^max)
+    EXPECT_DOUBLE_EQ(c[0].mu, 1);
+}
+
+TEST(MaafComponents, BoxesTileTheWedgeAndItsLensProjection) {
+    // Each component's box spans its Omega_y band and exactly the Omega_x range of the wedge
+    // inside that band (eqs. 6-8); the lens range is that Omega_x range mapped through
+    // Omega_u = s^u Omega_x (eq. 24 as corrected in maaf_components.h).
+    WedgeShape w;
+    w.omegaYMax = 3;
+    w.sMin = 0.7;
+    w.sMax = 2.2;
+    w.lens = true;
+    w.suMin = 0.3;
+    w.suMax = 0.9;
+    const int N = 3;
+    const double K = 2 * N - 1;
+    for (const auto& c : maafComponents(N, w)) {
+        double ylo = c.cy - c.sy, yhi = c.cy + c.sy;
+        EXPECT_NEAR(yhi - ylo, 2 * w.omegaYMax / K, 1e-12);
+        if (c.p == 0) continue;
+        double xlo = ylo / w.sMax, xhi = yhi / w.sMin;
+        EXPECT_NEAR(c.cx - c.sx, xlo, 1e-12);
+        EXPECT_NEAR(c.cx + c.sx, xhi, 1e-12);
+        EXPECT_NEAR(c.cu - c.su, w.suMin * xlo, 1e-12);
+        EXPECT_NEAR(c.cu + c.su, w.suMax * xhi, 1e-12);
+    }
+}
+
+namespace {
+
+/// Uniform parameters on every pixel, from maafComponents, as the renderer builds them.
+MaafPixel uniformParams(int pairs, bool lens) {
+    WedgeShape w;
+    w.omegaYMax = 0.8;
+    w.sMin = 0.6;
+    w.sMax = 1.5;
+    w.lens = lens;
+    w.suMin = 0.5;
+    w.suMax = 1.2;
+    w.omegaUMax = 6;
+    auto comps = maafComponents(pairs, w);
+    MaafPixel m;
+    for (int k = 0; k < 2; ++k) {
+        m.axis[k].pairs = pairs;
+        for (const auto& c : comps) {
+            m.axis[k].cx[c.p] = float(c.cx);
+            m.axis[k].sx[c.p] = float(c.sx * 1.5);  // std of a few pixels
+            m.axis[k].weight[c.p] = float((c.p ? 2 : 1) * c.mu);
+            m.axis[k].cy[c.p] = float(c.cy);
+            m.axis[k].sy[c.p] = float(c.sy);
+            m.axis[k].cu[c.p] = float(c.cu);
+            m.axis[k].su[c.p] = float(c.su);
+        }
+    }
+    return m;
+}
+
+}  // namespace
+
+TEST(MaafFilter, SeparableAccumulationEqualsDirectEq22) {
+    // A tiny image with a handful of samples per pixel: filter through the accumulations
+    // (eq. 23) and the two separable passes (eq. 21 per axis), then evaluate eq. 22 directly
+    // as the product of the two axes' 3D kernels summed over every sample of every pixel.
+    const int W = 9, H = 7, S = 5, pairs = 3;
+    Plane pl(W, H);
+    MaafPixel params = uniformParams(pairs, true);
+    Image<MaafPixel> pimg(W, H, params);
+    MaafOptions o;
+    o.pairs = pairs;
+    o.maxRadius = 20;  // the whole tiny image is inside every window
+    o.symmetricOuter = false;
+    MaafAccumulator acc(W, H, pairs, 3);
+    struct Smp {
+        float y[2], u[2];
+        Vec3f f;
+    };
+    std::vector<std::vector<Smp>> samples(W * H);
+    for (size_t p = 0; p < size_t(W * H); ++p) {
+        for (int s = 0; s < S; ++s) {
+            uint32_t k = uint32_t(p * 100 + s * 7);
+            Smp m{{rnd(k) * 2 - 1, rnd(k + 1) * 2 - 1}, {rnd(k + 2) * 2 - 1, rnd(k + 3) * 2 - 1},
+                  Vec3f(rnd(k + 4), rnd(k + 5), rnd(k + 6))};
+            samples[p].push_back(m);
+            acc.add(p, &m.f.x, 1.f, m.y, m.u, params);
+        }
+        acc.scale(p, 1.f / S);
+    }
+    Image3f fallback(W, H, Vec3f(-1.f));
+    Image3f sep = acc.filter(pimg, pl.fb, pl.frames, fallback, o);
+
+    auto axisKernel = [&](const MaafAxis& ax, double a, double y, double u) {
+        double sum = 0;
+        for (int c = 0; c < ax.pairs; ++c) {
+            double g = ax.weight[c] * ax.sx[c] / std::sqrt(2 * M_PI) * std::exp(-0.5 * sqr(ax.sx[c] * a));
+            double win = std::exp(-0.5 * (sqr(ax.sy[c] * y) + sqr(ax.su[c] * u)));
+            sum += g * win * std::cos(ax.cx[c] * a - (ax.cy[c] * y + ax.cu[c] * u));
+        }
+        return sum;
+    };
+    for (int y = 0; y < H; ++y)
+        for (int x = 0; x < W; ++x) {
+            double num[3] = {0, 0, 0}, den = 0;
+            for (int yy = 0; yy < H; ++yy)
+                for (int xx = 0; xx < W; ++xx)
+                    for (const Smp& m : samples[size_t(yy) * W + xx]) {
+                        double w = axisKernel(params.axis[0], x - xx, m.y[0], m.u[0]) *
+                                   axisKernel(params.axis[1], y - yy, m.y[1], m.u[1]) / S;
+                        for (int c = 0; c < 3; ++c) num[c] += w * m.f[c];
+                        den += w;
+                    }
+            ASSERT_GT(den, 0);
+            for (int c = 0; c < 3; ++c) EXPECT_NEAR(sep(x, y)[c], num[c] / den, 2e-4) << x << "," << y;
+        }
+}
+
+TEST(MaafFilter, ConstantSignalStaysConstantAndNoNan) {
+    const int W = 24, H = 20, pairs = 3;
+    Plane pl(W, H);
+    MaafPixel params = uniformParams(pairs, true);
+    Image<MaafPixel> pimg(W, H, params);
+    MaafOptions o;
+    o.pairs = pairs;
+    MaafAccumulator acc(W, H, pairs, 1);
+    for (size_t p = 0; p < size_t(W * H); ++p) {
+        if (p % 11 == 0) continue;  // pixels without samples
+        for (int s = 0; s < 4; ++s) {
+            uint32_t k = uint32_t(p * 31 + s);
+            float y[2] = {rnd(k) - 0.5f, rnd(k + 1) - 0.5f}, u[2] = {rnd(k + 2) - 0.5f, rnd(k + 3) - 0.5f};
+            float v = 0.75f;
+            acc.add(p, &v, 0.2f + rnd(k + 4), y, u, params);
+        }
+        acc.scale(p, 0.25f);
+    }
+    for (int i = 0; i < 10; ++i) pl.fb.object[size_t(i) * 37] = -1;
+    Image3f fallback(W, H, Vec3f(0.75f));
+    Image3f out = acc.filter(pimg, pl.fb, pl.frames, fallback, o);
+    for (size_t i = 0; i < out.size(); ++i) {
+        ASSERT_TRUE(isFinite(out[i]));
+        EXPECT_NEAR(out[i].x, 0.75f, 1e-4f);
+    }
+}
