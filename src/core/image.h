@@ -4,9 +4,14 @@
 
 #include <cassert>
 #include <cstddef>
+#include <algorithm>
 #include <vector>
 
 #include "core/math.h"
+#include "core/memory.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 
 namespace wedge {
 
@@ -14,7 +19,15 @@ template <class T>
 class Image {
 public:
     Image() = default;
-    Image(int width, int height, const T& fill = T{}) : m_width(width), m_height(height), m_data(size_t(width) * height, fill) {}
+    Image(int width, int height, const T& fill = T{}) : m_width(width), m_height(height) {
+        // Default-initialised storage filled in parallel: the first touch of the pages (and the
+        // kernel's zeroing of them) is spread over the worker threads.
+        m_data.resize(size_t(width) * height);
+        const size_t n = m_data.size();
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 1 << 16), [&](const tbb::blocked_range<size_t>& r) {
+            std::fill(m_data.begin() + r.begin(), m_data.begin() + r.end(), fill);
+        });
+    }
 
     int width() const { return m_width; }
     int height() const { return m_height; }
@@ -34,8 +47,6 @@ public:
 
     T* data() { return m_data.data(); }
     const T* data() const { return m_data.data(); }
-    std::vector<T>& vector() { return m_data; }
-    const std::vector<T>& vector() const { return m_data; }
 
     void fill(const T& v) { std::fill(m_data.begin(), m_data.end(), v); }
     bool sameSize(int w, int h) const { return m_width == w && m_height == h; }
@@ -44,7 +55,7 @@ public:
 
 private:
     int m_width = 0, m_height = 0;
-    std::vector<T> m_data;
+    LargeVector<T> m_data;
 };
 
 using Image1f = Image<float>;

@@ -214,7 +214,7 @@ Image3f MaafAccumulator::filter(const Image<MaafPixel>& params, const FrameBuffe
                                 const Image3f& fallback, const MaafOptions& o) const {
     const int W = m_width, H = m_height, B = m_bands, C = m_channels, V = m_values;
     const size_t istride = size_t(B + 1) * C;  // B bands of axis 2, plus the central-only band
-    std::vector<float> inter(size_t(W) * H * istride, 0.f);
+    LargeVector<float> inter(size_t(W) * H * istride, 0.f);
 
     // Pass 1 along image x: sum over the components p of axis 1 (eq. 21).
     parallelRows(H, [&](int y) {

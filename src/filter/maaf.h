@@ -128,7 +128,7 @@ public:
 private:
     int m_width, m_height, m_pairs, m_bands, m_values, m_channels;
     size_t m_stride;
-    std::vector<float> m_data;
+    LargeVector<float> m_data;
 };
 
 /// The secondary and lens coordinates of a sample along a pixel's two axes.

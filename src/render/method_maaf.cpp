@@ -68,8 +68,8 @@ void renderMaaf(const MethodContext& ctx, RenderResult& result) {
 
     Image<PixelStats> stats(W, H);
     FrameBuffers& fb = result.buffers;
-    std::vector<SampleRecord> records(pixels * n0);
-    std::vector<int8_t> slots(pixels * n0, -1);
+    LargeVector<SampleRecord> records(pixels * n0);
+    LargeVector<int8_t> slots(pixels * n0, -1);
 
     // 1. Initial sampling: 16 path samples with occluder spans; keep the records.
     Timer t;
