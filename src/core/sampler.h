@@ -28,11 +28,10 @@ constexpr uint32_t hash32(uint32_t x) {
 constexpr uint32_t hashCombine(uint32_t a, uint32_t b) { return hash32(a ^ (hash32(b) + 0x9e3779b9U + (a << 6) + (a >> 2))); }
 
 inline uint32_t reverseBits32(uint32_t x) {
+    x = __builtin_bswap32(x);  // bytes, then bits within bytes
     x = ((x >> 1) & 0x55555555U) | ((x & 0x55555555U) << 1);
     x = ((x >> 2) & 0x33333333U) | ((x & 0x33333333U) << 2);
-    x = ((x >> 4) & 0x0f0f0f0fU) | ((x & 0x0f0f0f0fU) << 4);
-    x = ((x >> 8) & 0x00ff00ffU) | ((x & 0x00ff00ffU) << 8);
-    return (x >> 16) | (x << 16);
+    return ((x >> 4) & 0x0f0f0f0fU) | ((x & 0x0f0f0f0fU) << 4);
 }
 
 /// Laine-Karras style permutation that only lets lower bits affect higher ones; applied to the
@@ -57,6 +56,14 @@ inline uint32_t sobol1(uint32_t index) {
         if (index & 1U) r ^= v;
     return r;
 }
+/// Dimension 1 with its bits reversed (Burley's "sobol_reversed"): the scramble works on
+/// reversed values, so generating them directly saves two bit reversals per point.
+inline uint32_t sobol1Reversed(uint32_t index) {
+    uint32_t r = 0;
+    for (uint32_t v = 1U; index; index >>= 1, v ^= v << 1)
+        if (index & 1U) r ^= v;
+    return r;
+}
 
 inline float toUnitFloat(uint32_t x) {
     // 24 high bits -> [0, 1), never exactly 1.
@@ -70,11 +77,13 @@ public:
     PixelSampler(uint32_t seed, uint32_t pixelIndex) : m_key(hashCombine(hash32(seed), pixelIndex)) {}
 
     /// The 2D point of dimension pair `pair` (dimensions 2*pair and 2*pair+1) for sample `index`.
+    /// nestedUniformScramble(sobol_d(i)) = reverse(laineKarras(reversed sobol_d(i))), and the
+    /// reversed dimension 0 is the index itself.
     Vec2f get2D(uint32_t index, uint32_t pair) const {
         uint32_t pairKey = hashCombine(m_key, pair);
-        uint32_t shuffled = nestedUniformScramble(index, hash32(pairKey ^ 0xa511e9b3U));
-        uint32_t a = nestedUniformScramble(sobol0(shuffled), hash32(pairKey ^ 0x63d83595U));
-        uint32_t b = nestedUniformScramble(sobol1(shuffled), hash32(pairKey ^ 0x9c0ee1d3U));
+        uint32_t shuffled = nestedUniformScramble(index, pairKey ^ 0xa511e9b3U);
+        uint32_t a = reverseBits32(laineKarras(shuffled, pairKey * 0x63d83595U + 1U));
+        uint32_t b = reverseBits32(laineKarras(sobol1Reversed(shuffled), pairKey * 0x9c0ee1d3U + 3U));
         return {toUnitFloat(a), toUnitFloat(b)};
     }
     float get1D(uint32_t index, uint32_t pair) const { return get2D(index, pair).x; }

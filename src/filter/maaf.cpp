@@ -63,7 +63,8 @@ MaafAxis buildAxis(const AxisInputs& in, const MaafOptions& o) {
         int kFit = int(std::floor(omegaX * maxRadius * in.step / 3.0));
         n = std::max(1, std::min(n, (kFit + 1) / 2));
     }
-    std::vector<MaafComponent> comps = maafComponents(n, w);
+    MaafComponent comps[kMaafMaxPairs];
+    maafComponents(n, w, comps);
     ax.pairs = n;
     for (int p = 0; p < n; ++p) {
         const MaafComponent& c = comps[p];
@@ -147,26 +148,30 @@ void MaafAccumulator::add(size_t pixel, const float* value, float weight, const 
                           const MaafPixel& params) {
     if (weight == 0.f) return;
     float A[2][2 * kMaafMaxPairs - 1] = {};
+    int used[2] = {1, 1};  // bands with a non-zero factor on each axis
     for (int k = 0; k < 2; ++k) {
         const MaafAxis& ax = params.axis[k];
-        for (int p = 0; p < ax.pairs && p < m_pairs; ++p) {
-            // Eq. 23: phase C_y y + C_u u, peak-one windows over the light (bounce) and the lens.
+        const int n = std::min(ax.pairs, m_pairs);
+        used[k] = 2 * n - 1;
+        for (int p = 0; p < n; ++p) {
+            // Eq. 23: phase C_y y + C_u u; optional windows over the light (bounce) and the lens.
             float wy = ax.sy[p] * y[k], wu = ax.su[p] * u[k];
-            float win = std::exp(-0.5f * (wy * wy + wu * wu));
+            float win = (wy == 0.f && wu == 0.f) ? 1.f : std::exp(-0.5f * (wy * wy + wu * wu));
             if (p == 0) {
                 A[k][0] = win;
             } else {
-                float phi = ax.cy[p] * y[k] + ax.cu[p] * u[k];
-                A[k][2 * p - 1] = win * std::cos(phi);
-                A[k][2 * p] = win * std::sin(phi);
+                float s, c;
+                sincosf(ax.cy[p] * y[k] + ax.cu[p] * u[k], &s, &c);
+                A[k][2 * p - 1] = win * c;
+                A[k][2 * p] = win * s;
             }
         }
     }
     float* d = &m_data[pixel * m_stride];
     const int C = m_channels, V = m_values;
-    for (int i = 0; i < m_bands; ++i) {
+    for (int i = 0; i < used[0]; ++i) {
         if (A[0][i] == 0.f) continue;
-        for (int j = 0; j < m_bands; ++j) {
+        for (int j = 0; j < used[1]; ++j) {
             float t = A[0][i] * A[1][j] * weight;
             float* e = d + C * (i * m_bands + j);
             for (int c = 0; c < V; ++c) e[c] += value[c] * t;

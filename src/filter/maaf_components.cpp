@@ -5,7 +5,12 @@
 namespace wedge::filter {
 
 std::vector<MaafComponent> maafComponents(int pairs, const WedgeShape& w) {
-    std::vector<MaafComponent> comps;
+    std::vector<MaafComponent> comps(size_t(std::max(pairs, 0)));
+    maafComponents(pairs, w, comps.data());
+    return comps;
+}
+
+void maafComponents(int pairs, const WedgeShape& w, MaafComponent* out) {
     const double K = 2.0 * pairs - 1.0;  // number of filters, 2N-1
     const double Om = w.omegaYMax;
     for (int p = 0; p < pairs; ++p) {
@@ -33,9 +38,8 @@ std::vector<MaafComponent> maafComponents(int pairs, const WedgeShape& w) {
         }
         // Eq. 10: a Gaussian over the whole double wedge.
         c.mu = fourierGaussian(c.cx, Om / w.sMin) * fourierGaussian(c.cy, Om);
-        comps.push_back(c);
+        out[p] = c;
     }
-    return comps;
 }
 
 double fourierGaussian(double w, double sigma) { return std::exp(-0.5 * w * w / (sigma * sigma)); }

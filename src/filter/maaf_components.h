@@ -42,6 +42,8 @@ struct WedgeShape {
 /// The N components p = 0..N-1 of MAAF with 2N-1 filters (N pairs counting the centre).
 /// Eqs. 6-8 place them; eq. 10 weighs them; the lens axis follows eq. 24 (corrected, above).
 std::vector<MaafComponent> maafComponents(int pairs, const WedgeShape& wedge);
+/// The same into out[0..pairs) without allocating (the renderer calls it for every pixel).
+void maafComponents(int pairs, const WedgeShape& wedge, MaafComponent* out);
 
 /// Peak-one Fourier Gaussian G(w; sigma).
 double fourierGaussian(double w, double sigma);

@@ -47,28 +47,41 @@ WedgeField prefilterWedges(const FrameBuffers& fb, const WedgeOptions& o) {
     // surface around them, so that every pixel inside a filter's window accumulates with the
     // same components as the pixel the filter is centred on (MAAF assumes they vary smoothly).
     if (o.fillRadius > o.radius) {
-        Image1f s1 = wf.s1, s2 = wf.s2, zMin = wf.zMin, zMax = wf.zMax;
+        // Separable: along rows, then along columns of the row results. Each pass compares a
+        // neighbour's surface with the pixel the pass is centred on.
+        struct Fill {
+            float s1, s2, z1, z2;
+        };
+        Image<Fill> row(W, H), col(W, H);
+        auto pass = [&](const Image<Fill>& src, Image<Fill>& dst, bool vertical) {
+            parallelRows(H, [&](int y) {
+                for (int x = 0; x < W; ++x) {
+                    size_t p = size_t(y) * W + x;
+                    Fill f{0, kInf, kInf, 0};
+                    if (fb.object[p] >= 0)
+                        for (int k = -o.fillRadius; k <= o.fillRadius; ++k) {
+                            int xx = vertical ? x : x + k, yy = vertical ? y + k : y;
+                            if (xx < 0 || xx >= W || yy < 0 || yy >= H) continue;
+                            size_t q = size_t(yy) * W + xx;
+                            if (!sameSurface(fb, p, q, o.normalCos)) continue;
+                            const Fill& g = src[q];
+                            if (g.s2 < kInf) { f.s1 = std::max(f.s1, g.s1); f.s2 = std::min(f.s2, g.s2); }
+                            if (g.z1 < kInf) { f.z1 = std::min(f.z1, g.z1); f.z2 = std::max(f.z2, g.z2); }
+                        }
+                    dst[p] = f;
+                }
+            });
+        };
+        Image<Fill> own(W, H);
+        for (size_t p = 0; p < own.size(); ++p) own[p] = {wf.s1[p], wf.s2[p], wf.zMin[p], wf.zMax[p]};
+        pass(own, row, false);
+        pass(row, col, true);
         parallelRows(H, [&](int y) {
             for (int x = 0; x < W; ++x) {
                 size_t p = size_t(y) * W + x;
                 if (fb.object[p] < 0) continue;
-                bool needShadow = s2[p] >= kInf, needBounce = zMin[p] >= kInf;
-                if (!needShadow && !needBounce) continue;
-                float a1 = 0, a2 = kInf, b1 = kInf, b2 = 0;
-                for (int dy = -o.fillRadius; dy <= o.fillRadius; ++dy) {
-                    int yy = y + dy;
-                    if (yy < 0 || yy >= H) continue;
-                    for (int dx = -o.fillRadius; dx <= o.fillRadius; ++dx) {
-                        int xx = x + dx;
-                        if (xx < 0 || xx >= W) continue;
-                        size_t q = size_t(yy) * W + xx;
-                        if (!sameSurface(fb, p, q, o.normalCos)) continue;
-                        if (s2[q] < kInf) { a1 = std::max(a1, s1[q]); a2 = std::min(a2, s2[q]); }
-                        if (zMin[q] < kInf) { b1 = std::min(b1, zMin[q]); b2 = std::max(b2, zMax[q]); }
-                    }
-                }
-                if (needShadow) { wf.s1[p] = a1; wf.s2[p] = a2; }
-                if (needBounce) { wf.zMin[p] = b1; wf.zMax[p] = b1 < kInf ? b2 : 0.f; }
+                if (wf.s2[p] >= kInf) { wf.s1[p] = col[p].s1; wf.s2[p] = col[p].s2; }
+                if (wf.zMin[p] >= kInf) { wf.zMin[p] = col[p].z1; wf.zMax[p] = col[p].z1 < kInf ? col[p].z2 : 0.f; }
             }
         });
     }

@@ -44,7 +44,8 @@ void renderAaf(const MethodContext& ctx, RenderResult& result) {
     uint64_t extraTotal = 0;
     for (size_t i = 0; i < extra.size(); ++i) {
         float need = std::max({params.sppDirect[i], params.sppIndirect[i], params.sppLens[i]});
-        extra[i] = uint32_t(std::clamp(int(std::ceil(need)) - int(n0), 0, cap));
+        extra[i] = std::max(uint32_t(std::clamp(int(std::ceil(need)) - int(n0), 0, cap)),
+                            stats[i].emitterTopUp(kEmitterEdgeSpp));
         extraTotal += extra[i];
     }
     result.seconds.add("prefilter", t.seconds());

@@ -4,23 +4,12 @@
 // FrameBuffers::compose(filtered light) = emission + coverage * albedo * filtered + off-surface samples.
 #include "filter/atrous.h"
 #include "render/methods.h"
-#include "render/sampling.h"
 
 namespace wedge::render {
 
 void renderAtrous(const MethodContext& ctx, RenderResult& result) {
-    const ViewGeometry& view = ctx.view;
-    Image<PixelStats> stats(view.width, view.height);
-    {
-        Progress progress("atrous sampling", uint64_t(view.width) * view.height * ctx.spp, !ctx.options.quiet);
-        Timer t;
-        result.rays = samplePixels(
-            ctx.sampler, stats, view, [&](int, int) { return SampleRange{0, uint32_t(ctx.spp)}; }, false, true,
-            [](int, int, const TracedSample&, int) {}, &progress);
-        progress.done();
-        storeStats(stats, ctx, result.buffers);
-        result.seconds.add("sampling", t.seconds());
-    }
+    Image<PixelStats> stats(ctx.view.width, ctx.view.height);
+    sampleUniform(ctx, "atrous sampling", stats, result);
     filter::AtrousParams params;
     params.iterations = ctx.options.atrousIterations;
     params.sigmaColor = ctx.options.atrousSigmaColor;

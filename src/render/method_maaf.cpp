@@ -103,9 +103,9 @@ void renderMaaf(const MethodContext& ctx, RenderResult& result) {
     for (size_t i = 0; i < pixels; ++i) {
         // Sec. 6.2: extra samples only where the wedge degenerates at the focal plane, at the
         // AAF (MYRD14) rates, since there the filter is the central, axis-aligned one.
-        if (params.fallback[i] == 0) continue;
-        float need = std::max({rates.sppDirect[i], rates.sppIndirect[i], rates.sppLens[i]});
-        extra[i] = uint32_t(std::clamp(int(std::ceil(need)) - int(n0), 0, cap));
+        float need = params.fallback[i] > 0 ? std::max({rates.sppDirect[i], rates.sppIndirect[i], rates.sppLens[i]}) : 0.f;
+        extra[i] = std::max(uint32_t(std::clamp(int(std::ceil(need)) - int(n0), 0, cap)),
+                            stats[i].emitterTopUp(kEmitterEdgeSpp));
         extraTotal += extra[i];
     }
     result.seconds.add("prefilter_slopes", t.seconds());

@@ -2,6 +2,8 @@
 // fills a RenderResult (colour, buffers, stage times, sample and ray counts).
 #pragma once
 
+#include <string>
+
 #include "core/progress.h"
 #include "render/path_sampler.h"
 #include "render/pixel_stats.h"
@@ -21,6 +23,13 @@ void renderMc(const MethodContext& ctx, RenderResult& result);
 void renderAaf(const MethodContext& ctx, RenderResult& result);
 void renderMaaf(const MethodContext& ctx, RenderResult& result);
 void renderAtrous(const MethodContext& ctx, RenderResult& result);
+
+/// Samples per pixel at emitter edges (PixelStats::emitterTopUp), for every method.
+constexpr uint32_t kEmitterEdgeSpp = 64;
+
+/// Monte Carlo sampling as `mc` does it: ctx.spp samples per pixel, then the emitter-edge
+/// top-up. Returns the number of rays; fills `stats` and result.buffers, times "sampling".
+void sampleUniform(const MethodContext& ctx, const std::string& label, Image<PixelStats>& stats, RenderResult& result);
 
 /// Stores every pixel's statistics into `fb`, with the closed-form unoccluded direct light.
 void storeStats(const Image<PixelStats>& stats, const MethodContext& ctx, FrameBuffers& fb);

@@ -50,6 +50,7 @@ int PixelStats::add(const TracedSample& s, const ViewGeometry& view, bool slopes
     Vec3f l = r.direct + r.indirect;
     color += s.emission + s.albedo * l;
     emission += s.emission;
+    if (maxComponent(s.emission) > 0) ++nEmitter;
     light += s.albedo * l;
     float lum = luminance(l);
     lumSum += lum;

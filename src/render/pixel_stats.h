@@ -41,7 +41,7 @@ struct SurfaceSlot {
 struct PixelStats {
     Vec3f color{0.f}, emission{0.f}, light{0.f};  // light: sum of albedo * (direct + indirect)
     float lumSum = 0, lumSq = 0;
-    uint32_t n = 0;
+    uint32_t n = 0, nEmitter = 0;  // nEmitter: samples that saw an emitter
     SurfaceSlot slot[2];
 
     /// Adds a sample; returns the surface slot it went to (0, 1) or -1 (background or a third surface).
@@ -49,6 +49,11 @@ struct PixelStats {
     int primary() const { return slot[1].n > slot[0].n ? 1 : 0; }
     /// True when the sample lies on the pixel's primary surface (as far as the samples so far tell).
     bool onPrimary(const TracedSample& s) const { return s.hit && slot[primary()].matches(s); }
+    /// Extra samples that bring a pixel partly covering an emitter up to `target`: no filter can
+    /// reach emitted light, and a bright edge seen by few samples dominates any relative error.
+    uint32_t emitterTopUp(uint32_t target) const {
+        return (nEmitter > 0 && nEmitter < n && n < target) ? target - n : 0;
+    }
     /// Writes this pixel into every plane of `fb`.
     void store(FrameBuffers& fb, int x, int y, const ViewGeometry& view) const;
 };

@@ -32,17 +32,26 @@ double averageSpp(const FrameBuffers& fb) {
     return fb.spp.empty() ? 0 : s / double(fb.spp.size());
 }
 
-void renderMc(const MethodContext& ctx, RenderResult& result) {
+void sampleUniform(const MethodContext& ctx, const std::string& label, Image<PixelStats>& stats, RenderResult& result) {
     const ViewGeometry& view = ctx.view;
-    Image<PixelStats> stats(view.width, view.height);
-    Progress progress("mc sampling", uint64_t(view.width) * view.height * ctx.spp, !ctx.options.quiet);
     Timer t;
-    result.rays = samplePixels(
+    Progress progress(label, uint64_t(view.width) * view.height * ctx.spp, !ctx.options.quiet);
+    result.rays += samplePixels(
         ctx.sampler, stats, view, [&](int, int) { return SampleRange{0, uint32_t(ctx.spp)}; }, false, true,
         [](int, int, const TracedSample&, int) {}, &progress);
     progress.done();
+    // Pixels at the edge of a visible emitter get topped up, as in every method.
+    result.rays += samplePixels(
+        ctx.sampler, stats, view,
+        [&](int x, int y) { return SampleRange{uint32_t(ctx.spp), stats(x, y).emitterTopUp(kEmitterEdgeSpp)}; }, false,
+        false, [](int, int, const TracedSample&, int) {}, nullptr);
     storeStats(stats, ctx, result.buffers);
     result.seconds.add("sampling", t.seconds());
+}
+
+void renderMc(const MethodContext& ctx, RenderResult& result) {
+    Image<PixelStats> stats(ctx.view.width, ctx.view.height);
+    sampleUniform(ctx, "mc sampling", stats, result);
     result.color = result.buffers.color;
 }
 
