@@ -171,7 +171,7 @@ TEST(Render, ThinLensRaysMeetOnTheFocalPlane) {
 }
 
 TEST(Render, ImageIsBitIdenticalOnOneAndTwoThreads) {
-    for (const char* method : {"mc"}) {
+    for (const char* method : {"mc", "aaf", "maaf", "atrous"}) {
         render::RenderOptions o;
         o.quiet = true;
         o.method = method;

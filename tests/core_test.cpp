@@ -1,0 +1,79 @@
+// Core and I/O: the per-pixel sample generator's stratification and determinism, and image
+// files written and read back (EXR with named channels, PFM orientation, PNG sRGB).
+#include <gtest/gtest.h>
+
+#include <filesystem>
+
+#include "core/error.h"
+#include "core/sampler.h"
+#include "io/image_io.h"
+#include "test_util.h"
+
+using namespace wedge;
+
+TEST(Sampler, EveryPowerOfTwoPrefixIsStratified) {
+    // (0,2)-sequence in base 2: the first 2^k points of a pair fall one in each elementary
+    // interval of area 2^-k (checked for 4x4, 16x1 and 1x16 with 16 points, 8x8 with 64).
+    for (uint32_t pixel = 0; pixel < 40; ++pixel) {
+        PixelSampler s(17, pixel);
+        for (uint32_t pair = 0; pair < 6; ++pair) {
+            int a[16] = {}, b[16] = {}, c[16] = {}, d[64] = {};
+            for (uint32_t i = 0; i < 64; ++i) {
+                Vec2f v = s.get2D(i, pair);
+                ASSERT_GE(v.x, 0.f);
+                ASSERT_LT(v.x, 1.f);
+                if (i < 16) {
+                    ++a[int(v.x * 4) * 4 + int(v.y * 4)];
+                    ++b[int(v.x * 16)];
+                    ++c[int(v.y * 16)];
+                }
+                ++d[int(v.x * 8) * 8 + int(v.y * 8)];
+            }
+            for (int k = 0; k < 16; ++k) ASSERT_TRUE(a[k] == 1 && b[k] == 1 && c[k] == 1) << pixel << " " << pair;
+            for (int k = 0; k < 64; ++k) ASSERT_EQ(d[k], 1);
+        }
+    }
+}
+
+TEST(Sampler, DependsOnlyOnSeedPixelIndexAndPair) {
+    PixelSampler a(5, 123), b(5, 123), c(6, 123), d(5, 124);
+    EXPECT_EQ(a.get2D(7, 2).x, b.get2D(7, 2).x);
+    EXPECT_NE(a.get2D(7, 2).x, c.get2D(7, 2).x);
+    EXPECT_NE(a.get2D(7, 2).x, d.get2D(7, 2).x);
+    EXPECT_NE(a.get2D(7, 2).x, a.get2D(7, 3).x);
+    EXPECT_EQ(reverseBits32(sobol1Reversed(12345)), sobol1(12345));
+}
+
+TEST(ImageIo, RoundTrips) {
+    std::string dir = test::tempDir();
+    Image3f img(5, 3);
+    for (int y = 0; y < 3; ++y)
+        for (int x = 0; x < 5; ++x) img(x, y) = Vec3f(0.1f * x, 0.2f * y, 0.05f * (x + y));
+    io::writeColor(dir + "/a.exr", img);
+    io::writeColor(dir + "/a.pfm", img);
+    io::writeColor(dir + "/a.png", img);
+    Image3f e = io::readColor(dir + "/a.exr"), p = io::readColor(dir + "/a.pfm"), q = io::readColor(dir + "/a.png");
+    for (size_t i = 0; i < img.size(); ++i) {
+        EXPECT_EQ(e[i], img[i]);
+        EXPECT_EQ(p[i], img[i]);  // PFM rows are bottom to top on disk; the reader flips them back
+        for (int c = 0; c < 3; ++c) EXPECT_NEAR(q[i][c], img[i][c], 0.01f);  // 8-bit sRGB
+    }
+    // Named channels.
+    float plane[15];
+    for (int i = 0; i < 15; ++i) plane[i] = float(i);
+    io::writeExr(dir + "/b.exr", 5, 3, {{"depth", plane, 1}});
+    io::ExrImage b = io::readExr(dir + "/b.exr");
+    ASSERT_TRUE(b.channels.count("depth"));
+    EXPECT_EQ(b.channels["depth"][7], 7.f);
+}
+
+TEST(ImageIo, BadFilesAreErrors) {
+    std::string dir = test::tempDir();
+    test::writeFile(dir + "/x.png", "not a png");
+    test::writeFile(dir + "/x.pfm", "PF\n-3 2\n-1\n");
+    test::writeFile(dir + "/x.exr", "garbage");
+    for (const char* f : {"/x.png", "/x.pfm", "/x.exr", "/missing.png"}) EXPECT_THROW(io::readColor(dir + f), Error) << f;
+    EXPECT_THROW(io::readColor(dir + "/x.bmp"), Error);
+    EXPECT_THROW(io::checkOutputPath(dir + "/y.jpg", {".png"}), Error);
+    EXPECT_FALSE(std::filesystem::exists(dir + "/y.jpg"));
+}
