@@ -74,13 +74,18 @@ inline float toUnitFloat(uint32_t x) {
 /// (pixel, index, pair) always yields the same point.
 class PixelSampler {
 public:
-    PixelSampler(uint32_t seed, uint32_t pixelIndex) : m_key(hashCombine(hash32(seed), pixelIndex)) {}
+    static constexpr uint32_t kPairs = 8;  // dimension pairs a path sample may use
+
+    PixelSampler(uint32_t seed, uint32_t pixelIndex) {
+        uint32_t key = hashCombine(hash32(seed), pixelIndex);
+        for (uint32_t p = 0; p < kPairs; ++p) m_pairKey[p] = hashCombine(key, p);
+    }
 
     /// The 2D point of dimension pair `pair` (dimensions 2*pair and 2*pair+1) for sample `index`.
     /// nestedUniformScramble(sobol_d(i)) = reverse(laineKarras(reversed sobol_d(i))), and the
     /// reversed dimension 0 is the index itself.
     Vec2f get2D(uint32_t index, uint32_t pair) const {
-        uint32_t pairKey = hashCombine(m_key, pair);
+        uint32_t pairKey = m_pairKey[pair % kPairs];
         uint32_t shuffled = nestedUniformScramble(index, pairKey ^ 0xa511e9b3U);
         uint32_t a = reverseBits32(laineKarras(shuffled, pairKey * 0x63d83595U + 1U));
         uint32_t b = reverseBits32(laineKarras(sobol1Reversed(shuffled), pairKey * 0x9c0ee1d3U + 3U));
@@ -89,7 +94,7 @@ public:
     float get1D(uint32_t index, uint32_t pair) const { return get2D(index, pair).x; }
 
 private:
-    uint32_t m_key;
+    uint32_t m_pairKey[kPairs];
 };
 
 }  // namespace wedge

@@ -5,6 +5,7 @@ namespace wedge::render {
 PathSampler::PathSampler(const scene::Scene& scene, const Camera& camera, bool indirect, uint32_t seed)
     : m_scene(scene), m_camera(camera), m_indirect(indirect), m_seed(seed) {
     m_epsilon = 1e-5f * scene.extent();
+    m_needChoice = scene.desc().lights.size() > 1 || scene.desc().hasMotion();
     float total = 0;
     for (const auto& l : scene.desc().lights) {
         total += std::max(1e-12f, luminance(l.radiance) * l.area());
@@ -52,86 +53,137 @@ PathSampler::LightSample PathSampler::sampleLight(const Vec3f& p, const Vec3f& n
 }
 
 TracedSample PathSampler::trace(int x, int y, uint32_t index, bool span) const {
-    PixelSampler rng(m_seed, uint32_t(y) * uint32_t(m_camera.width()) + uint32_t(x));
     TracedSample out;
-    Vec2f pix = rng.get2D(index, kPixel);
-    Vec2f lensU = rng.get2D(index, kLens);
-    Vec2f choice = rng.get2D(index, kChoice);
-    float time = choice.y;
-    Vec2f lens = m_camera.hasLens() ? concentricDisc(lensU.x, lensU.y) : Vec2f{0, 0};
-    out.record.lens = lens;
-
-    Ray ray = m_camera.generate(float(x) + pix.x, float(y) + pix.y, lens);
-    scene::Hit hit;
-    ++out.rays;
-    if (!m_scene.intersect(ray.origin, ray.direction, 0.f, kInf, time, hit)) return out;
-
-    const scene::Material& mat = m_scene.material(hit.material);
-    bool front = dot(hit.normal, ray.direction) < 0;
-    Vec3f n = front ? hit.normal : -hit.normal;  // two-sided shading
-    out.hit = true;
-    out.albedo = mat.albedo;
-    out.normal = n;
-    out.position = hit.position;
-    out.depth = m_camera.depth(hit.position);
-    out.object = hit.object;
-    if (front) out.emission = mat.emission;  // emitters shine from their front side
-
-    // Direct light at the primary hit.
-    const auto& lights = m_scene.desc().lights;
-    LightSample ls = sampleLight(hit.position, n, rng.get2D(index, kLight), choice.x);
-    out.record.light = ls.light;
-    out.record.lightPoint = ls.point;
-    if (maxComponent(ls.irradiance) > 0) {
-        out.record.unoccluded = luminance(ls.irradiance) * kInvPi;
-        Vec3f org = offset(hit.position, n);
-        Vec3f toPoint = ls.point - org;
-        float dist = length(toPoint);
-        Vec3f dir = toPoint / dist;
-        float tMax = dist * (1.f - 1e-4f);
-        out.shadowTested = true;
-        out.d1 = length(lights[ls.light].center() - hit.position);
-        ++out.rays;
-        if (span) {
-            scene::OccluderSpan s = m_scene.occluders(org, dir, 0.f, tMax, time);
-            out.occluded = s.occluded;
-            out.tNear = s.tNear;
-            out.tFar = s.tFar;
-        } else {
-            out.occluded = m_scene.occluded(org, dir, 0.f, tMax, time);
-        }
-        if (!out.occluded) out.record.direct = ls.irradiance * kInvPi;
-    }
-
-    // One diffuse bounce, lit by its own light sample.
-    if (m_indirect && maxComponent(mat.albedo) > 0) {
-        Vec2f ub = rng.get2D(index, kBounce);
-        Frame frame(n);
-        Vec3f dir = frame.toWorld(cosineHemisphere(ub.x, ub.y));
-        out.record.bounceDir = dir;
-        scene::Hit h2;
-        ++out.rays;
-        if (m_scene.intersect(offset(hit.position, n), dir, 0.f, kInf, time, h2)) {
-            out.bounceHit = true;
-            out.bounceDistance = h2.t;
-            const scene::Material& m2 = m_scene.material(h2.material);
-            Vec3f n2 = dot(h2.normal, dir) < 0 ? h2.normal : -h2.normal;
-            if (maxComponent(m2.albedo) > 0) {
-                LightSample l2 = sampleLight(h2.position, n2, rng.get2D(index, kBounceLight), choice.x);
-                if (maxComponent(l2.irradiance) > 0) {
-                    Vec3f org2 = offset(h2.position, n2);
-                    Vec3f toPoint = l2.point - org2;
-                    float dist = length(toPoint);
-                    ++out.rays;
-                    if (!m_scene.occluded(org2, toPoint / dist, 0.f, dist * (1.f - 1e-4f), time))
-                        // Cosine-weighted bounce: (albedo/pi) L cos / (cos/pi) = albedo L, so the
-                        // demodulated indirect is the incident radiance L = albedo2 E2 / pi.
-                        out.record.indirect = m2.albedo * l2.irradiance * kInvPi;
-                }
-            }
-        }
-    }
+    traceBatch(x, y, index, 1, span, &out);
     return out;
+}
+
+void PathSampler::traceBatch(int x, int y, uint32_t first, uint32_t count, bool span, TracedSample* outs) const {
+    constexpr int K = scene::RayPacket::kSize;
+    const PixelSampler rng(m_seed, uint32_t(y) * uint32_t(m_camera.width()) + uint32_t(x));
+    const auto& lights = m_scene.desc().lights;
+    for (uint32_t base = 0; base < count; base += K) {
+        const int n = int(std::min<uint32_t>(K, count - base));
+        TracedSample* out = outs + base;
+        float time[K], choice[K];
+        const scene::Material* mat[K] = {};
+        Vec3f normal[K];
+        LightSample ls[K], l2[K];
+
+        // Primary rays through the lens.
+        scene::RayPacket primary;
+        for (int k = 0; k < n; ++k) {
+            uint32_t index = first + base + uint32_t(k);
+            out[k] = TracedSample();
+            Vec2f pix = rng.get2D(index, kPixel);
+            // Dimensions only drawn where they matter (the values do not depend on it).
+            Vec2f c = m_needChoice ? rng.get2D(index, kChoice) : Vec2f{0, 0};
+            choice[k] = c.x;
+            time[k] = c.y;
+            Vec2f lens{0, 0};
+            if (m_camera.hasLens()) {
+                Vec2f lensU = rng.get2D(index, kLens);
+                lens = concentricDisc(lensU.x, lensU.y);
+            }
+            out[k].record.lens = lens;
+            Ray ray = m_camera.generate(float(x) + pix.x, float(y) + pix.y, lens);
+            primary.set(k, ray.origin, ray.direction, kInf, time[k]);
+            out[k].rays = 1;
+        }
+        scene::Hit hit[K];
+        bool found[K] = {};
+        m_scene.intersect(primary, hit, found, true);
+
+        // Direct light at the primary hits: one light sample and shadow ray each.
+        scene::RayPacket shadow;
+        for (int k = 0; k < n; ++k) {
+            if (!found[k]) continue;
+            uint32_t index = first + base + uint32_t(k);
+            mat[k] = &m_scene.material(hit[k].material);
+            bool front = dot(hit[k].normal, primary.dir[k]) < 0;
+            normal[k] = front ? hit[k].normal : -hit[k].normal;  // two-sided shading
+            TracedSample& o = out[k];
+            o.hit = true;
+            o.albedo = mat[k]->albedo;
+            o.normal = normal[k];
+            o.position = hit[k].position;
+            o.depth = m_camera.depth(hit[k].position);
+            o.object = hit[k].object;
+            if (front) o.emission = mat[k]->emission;  // emitters shine from their front side
+            ls[k] = sampleLight(hit[k].position, normal[k], rng.get2D(index, kLight), choice[k]);
+            o.record.light = ls[k].light;
+            o.record.lightPoint = ls[k].point;
+            if (maxComponent(ls[k].irradiance) <= 0) continue;
+            o.record.unoccluded = luminance(ls[k].irradiance) * kInvPi;
+            Vec3f org = offset(hit[k].position, normal[k]);
+            Vec3f toPoint = ls[k].point - org;
+            float dist = length(toPoint);
+            shadow.set(k, org, toPoint / dist, dist * (1.f - 1e-4f), time[k]);
+            o.shadowTested = true;
+            o.d1 = length(lights[ls[k].light].center() - hit[k].position);
+            ++o.rays;
+        }
+        if (shadow.any()) {
+            if (span) {
+                scene::OccluderSpan spans[K];
+                m_scene.occluders(shadow, spans);
+                for (int k = 0; k < n; ++k) {
+                    out[k].occluded = spans[k].occluded;
+                    out[k].tNear = spans[k].tNear;
+                    out[k].tFar = spans[k].tFar;
+                }
+            } else {
+                bool occ[K];
+                m_scene.occluded(shadow, occ);
+                for (int k = 0; k < n; ++k) out[k].occluded = occ[k];
+            }
+            for (int k = 0; k < n; ++k)
+                if (shadow.valid[k] && !out[k].occluded) out[k].record.direct = ls[k].irradiance * kInvPi;
+        }
+        if (!m_indirect) continue;
+
+        // One cosine-weighted bounce per sample.
+        scene::RayPacket bounce;
+        for (int k = 0; k < n; ++k) {
+            if (!found[k] || maxComponent(mat[k]->albedo) <= 0) continue;
+            Vec2f ub = rng.get2D(first + base + uint32_t(k), kBounce);
+            Vec3f dir = Frame(normal[k]).toWorld(cosineHemisphere(ub.x, ub.y));
+            out[k].record.bounceDir = dir;
+            bounce.set(k, offset(hit[k].position, normal[k]), dir, kInf, time[k]);
+            ++out[k].rays;
+        }
+        if (!bounce.any()) continue;
+        scene::Hit h2[K];
+        bool found2[K] = {};
+        m_scene.intersect(bounce, h2, found2, false);
+
+        // The bounce hit lit by its own light sample.
+        scene::RayPacket shadow2;
+        const scene::Material* m2[K] = {};
+        for (int k = 0; k < n; ++k) {
+            if (!found2[k]) continue;
+            out[k].bounceHit = true;
+            out[k].bounceDistance = h2[k].t;
+            m2[k] = &m_scene.material(h2[k].material);
+            if (maxComponent(m2[k]->albedo) <= 0) continue;
+            Vec3f n2 = dot(h2[k].normal, bounce.dir[k]) < 0 ? h2[k].normal : -h2[k].normal;
+            l2[k] = sampleLight(h2[k].position, n2, rng.get2D(first + base + uint32_t(k), kBounceLight), choice[k]);
+            if (maxComponent(l2[k].irradiance) <= 0) continue;
+            Vec3f org2 = offset(h2[k].position, n2);
+            Vec3f toPoint = l2[k].point - org2;
+            float dist = length(toPoint);
+            shadow2.set(k, org2, toPoint / dist, dist * (1.f - 1e-4f), time[k]);
+            ++out[k].rays;
+        }
+        if (!shadow2.any()) continue;
+        bool occ2[K];
+        m_scene.occluded(shadow2, occ2);
+        for (int k = 0; k < n; ++k)
+            if (shadow2.valid[k] && !occ2[k])
+                // Cosine-weighted bounce: (albedo/pi) L cos / (cos/pi) = albedo L, so the
+                // demodulated indirect is the incident radiance L = albedo2 E2 / pi.
+                out[k].record.indirect = m2[k]->albedo * l2[k].irradiance * kInvPi;
+    }
 }
 
 }  // namespace wedge::render

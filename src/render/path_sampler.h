@@ -44,6 +44,10 @@ public:
     /// Traces sample `index` of pixel (x, y). With `span`, the primary shadow ray collects the
     /// nearest and farthest occluder (all hits along it) instead of stopping at the first.
     TracedSample trace(int x, int y, uint32_t index, bool span) const;
+    /// Traces samples first .. first+count-1 of pixel (x, y) into out[0..count), up to 16 at a
+    /// time as Embree ray packets (a pixel's primary and shadow rays are coherent). The same
+    /// samples as trace() one by one.
+    void traceBatch(int x, int y, uint32_t first, uint32_t count, bool span, TracedSample* out) const;
 
     const Camera& camera() const { return m_camera; }
     const scene::Scene& scene() const { return m_scene; }
@@ -65,6 +69,7 @@ private:
     bool m_indirect;
     uint32_t m_seed;
     float m_epsilon;
+    bool m_needChoice;  // light choice or shutter time vary
     std::vector<float> m_lightCdf;  // light choice proportional to power
 };
 

@@ -29,11 +29,15 @@ uint64_t samplePixels(const PathSampler& sampler, Image<PixelStats>& stats, cons
             for (int x = x0; x < x1; ++x) {
                 SampleRange r = range(x, y);
                 PixelStats& ps = stats(x, y);
-                for (uint32_t i = 0; i < r.count; ++i) {
-                    TracedSample s = sampler.trace(x, y, r.first + i, span);
-                    int slot = ps.add(s, view, slopes);
-                    sink(x, y, s, slot);
-                    localRays += s.rays;
+                TracedSample batch[16];
+                for (uint32_t i = 0; i < r.count; i += 16) {
+                    uint32_t n = std::min<uint32_t>(16, r.count - i);
+                    sampler.traceBatch(x, y, r.first + i, n, span, batch);
+                    for (uint32_t k = 0; k < n; ++k) {
+                        int slot = ps.add(batch[k], view, slopes);
+                        sink(x, y, batch[k], slot);
+                        localRays += batch[k].rays;
+                    }
                 }
                 localSamples += r.count;
             }

@@ -16,21 +16,50 @@ void embreeError(void*, RTCError code, const char* str) {
 }
 
 /// Intersection context that records every hit and rejects it, so traversal visits all of them.
+/// Per packet lane, found through the ray id (robust to Embree calling the filter with any N).
 struct SpanContext {
     RTCIntersectContext context;
-    float tNear, tFar;
-    bool any;
+    float tNear[RayPacket::kSize], tFar[RayPacket::kSize];
+    bool any[RayPacket::kSize];
 };
 
 void spanFilter(const RTCFilterFunctionNArguments* args) {
     auto* ctx = reinterpret_cast<SpanContext*>(args->context);
     for (unsigned i = 0; i < args->N; ++i) {
         if (args->valid[i] != -1) continue;
+        unsigned lane = RTCRayN_id(args->ray, args->N, i);
         float t = RTCRayN_tfar(args->ray, args->N, i);  // the candidate hit distance
-        ctx->tNear = std::min(ctx->tNear, t);
-        ctx->tFar = std::max(ctx->tFar, t);
-        ctx->any = true;
+        ctx->tNear[lane] = std::min(ctx->tNear[lane], t);
+        ctx->tFar[lane] = std::max(ctx->tFar[lane], t);
+        ctx->any[lane] = true;
         args->valid[i] = 0;  // reject: keep traversing
+    }
+}
+
+void initSpan(SpanContext& sc) {
+    rtcInitIntersectContext(&sc.context);
+    sc.context.filter = spanFilter;
+    for (int i = 0; i < RayPacket::kSize; ++i) {
+        sc.tNear[i] = kInf;
+        sc.tFar[i] = 0;
+        sc.any[i] = false;
+    }
+}
+
+void toRtc(const RayPacket& r, RTCRay16& ray) {
+    for (int i = 0; i < RayPacket::kSize; ++i) {
+        ray.org_x[i] = r.org[i].x;
+        ray.org_y[i] = r.org[i].y;
+        ray.org_z[i] = r.org[i].z;
+        ray.dir_x[i] = r.dir[i].x;
+        ray.dir_y[i] = r.dir[i].y;
+        ray.dir_z[i] = r.dir[i].z;
+        ray.tnear[i] = 0.f;
+        ray.tfar[i] = r.valid[i] ? r.tFar[i] : -kInf;
+        ray.time[i] = r.time[i];
+        ray.mask[i] = 0xffffffffu;
+        ray.id[i] = unsigned(i);
+        ray.flags[i] = 0;
     }
 }
 
@@ -127,23 +156,75 @@ Scene::~Scene() {
     if (m_device) rtcReleaseDevice(m_device);
 }
 
+void Scene::fillHit(const Vec3f& org, const Vec3f& dir, float t, unsigned geomID, unsigned primID, const Vec3f& ng,
+                    Hit& hit) const {
+    const GeometryInfo& g = m_geometry[geomID];
+    hit.t = t;
+    hit.position = org + dir * t;
+    // Embree's Ng is the counter-clockwise normal for triangles and points outward for spheres
+    // (tests/scene_test.cpp checks both), which is our front side.
+    hit.normal = normalize(ng);
+    hit.material = g.materialIds ? g.materialIds[primID] : g.material;
+    // Spheres: one surface each; meshes: one per shape.
+    hit.object = g.object + (g.sphere ? primID : (g.shapeIds ? g.shapeIds[primID] : 0));
+}
+
 bool Scene::intersect(const Vec3f& org, const Vec3f& dir, float tNear, float tFar, float time, Hit& hit) const {
     RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
     RTCRayHit rh = makeRayHit(org, dir, tNear, tFar, time);
     rtcIntersect1(m_scene, &ctx, &rh);
     if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
-    const GeometryInfo& g = m_geometry[rh.hit.geomID];
-    hit.t = rh.ray.tfar;
-    hit.position = org + dir * rh.ray.tfar;
-    Vec3f ng(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z);
-    // Embree's Ng is the counter-clockwise normal for triangles and points outward for spheres
-    // (tests/scene_test.cpp checks both), which is our front side.
-    hit.normal = normalize(ng);
-    hit.material = g.materialIds ? g.materialIds[rh.hit.primID] : g.material;
-    // Spheres: one surface each; meshes: one per shape.
-    hit.object = g.object + (g.sphere ? rh.hit.primID : (g.shapeIds ? g.shapeIds[rh.hit.primID] : 0));
+    fillHit(org, dir, rh.ray.tfar, rh.hit.geomID, rh.hit.primID, Vec3f(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z), hit);
     return true;
+}
+
+void Scene::intersect(const RayPacket& rays, Hit hits[RayPacket::kSize], bool found[RayPacket::kSize], bool coherent) const {
+    if (!coherent) {
+        // Measured on Sponza: incoherent bounce rays are faster one by one than as a packet
+        // or an Embree ray stream.
+        for (int k = 0; k < RayPacket::kSize; ++k)
+            found[k] = rays.valid[k] && intersect(rays.org[k], rays.dir[k], 0.f, rays.tFar[k], rays.time[k], hits[k]);
+        return;
+    }
+    RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+    alignas(64) RTCRayHit16 rh;
+    toRtc(rays, rh.ray);
+    for (int i = 0; i < RayPacket::kSize; ++i) {
+        rh.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
+        rh.hit.instID[0][i] = RTC_INVALID_GEOMETRY_ID;
+    }
+    rtcIntersect16(rays.valid, m_scene, &ctx, &rh);
+    for (int i = 0; i < RayPacket::kSize; ++i) {
+        found[i] = rays.valid[i] && rh.hit.geomID[i] != RTC_INVALID_GEOMETRY_ID;
+        if (found[i])
+            fillHit(rays.org[i], rays.dir[i], rh.ray.tfar[i], rh.hit.geomID[i], rh.hit.primID[i],
+                    Vec3f(rh.hit.Ng_x[i], rh.hit.Ng_y[i], rh.hit.Ng_z[i]), hits[i]);
+    }
+}
+
+void Scene::occluded(const RayPacket& rays, bool occluded[RayPacket::kSize]) const {
+    RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    alignas(64) RTCRay16 ray;
+    toRtc(rays, ray);
+    rtcOccluded16(rays.valid, m_scene, &ctx, &ray);
+    for (int i = 0; i < RayPacket::kSize; ++i) occluded[i] = rays.valid[i] && ray.tfar[i] < 0;
+}
+
+void Scene::occluders(const RayPacket& rays, OccluderSpan spans[RayPacket::kSize]) const {
+    SpanContext sc;
+    initSpan(sc);
+    alignas(64) RTCRayHit16 rh;
+    toRtc(rays, rh.ray);
+    for (int i = 0; i < RayPacket::kSize; ++i) {
+        rh.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
+        rh.hit.instID[0][i] = RTC_INVALID_GEOMETRY_ID;
+    }
+    rtcIntersect16(rays.valid, m_scene, &sc.context, &rh);
+    for (int i = 0; i < RayPacket::kSize; ++i) spans[i] = {rays.valid[i] && sc.any[i], sc.tNear[i], sc.tFar[i]};
 }
 
 bool Scene::occluded(const Vec3f& org, const Vec3f& dir, float tNear, float tFar, float time) const {
@@ -156,14 +237,10 @@ bool Scene::occluded(const Vec3f& org, const Vec3f& dir, float tNear, float tFar
 
 OccluderSpan Scene::occluders(const Vec3f& org, const Vec3f& dir, float tNear, float tFar, float time) const {
     SpanContext sc;
-    rtcInitIntersectContext(&sc.context);
-    sc.context.filter = spanFilter;
-    sc.tNear = kInf;
-    sc.tFar = 0;
-    sc.any = false;
+    initSpan(sc);
     RTCRayHit rh = makeRayHit(org, dir, tNear, tFar, time);
-    rtcIntersect1(m_scene, &sc.context, &rh);
-    return {sc.any, sc.tNear, sc.tFar};
+    rtcIntersect1(m_scene, &sc.context, &rh);  // ray id 0: lane 0
+    return {sc.any[0], sc.tNear[0], sc.tFar[0]};
 }
 
 }  // namespace wedge::scene

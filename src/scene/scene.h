@@ -27,6 +27,27 @@ struct OccluderSpan {
     float tNear = kInf, tFar = 0.f;
 };
 
+/// Up to 16 rays as structure of arrays, for Embree's 16-wide packet queries. Lanes with
+/// valid[i] = 0 are ignored.
+struct RayPacket {
+    static constexpr int kSize = 16;
+    alignas(64) int valid[kSize] = {};
+    Vec3f org[kSize], dir[kSize];
+    float tFar[kSize] = {}, time[kSize] = {};
+    void set(int lane, const Vec3f& o, const Vec3f& d, float tMax, float t) {
+        valid[lane] = -1;
+        org[lane] = o;
+        dir[lane] = d;
+        tFar[lane] = tMax;
+        time[lane] = t;
+    }
+    bool any() const {
+        for (int v : valid)
+            if (v) return true;
+        return false;
+    }
+};
+
 class Scene {
 public:
     explicit Scene(SceneDesc desc);
@@ -46,7 +67,16 @@ public:
     bool occluded(const Vec3f& org, const Vec3f& dir, float tNear, float tFar, float time) const;
     OccluderSpan occluders(const Vec3f& org, const Vec3f& dir, float tNear, float tFar, float time) const;
 
+    /// Packet versions (tNear = 0): coherent rays of one pixel's samples traverse together.
+    /// `coherent`: trace as one packet (a pixel's primary rays); otherwise ray by ray (bounces).
+    void intersect(const RayPacket& rays, Hit hits[RayPacket::kSize], bool found[RayPacket::kSize], bool coherent) const;
+    void occluded(const RayPacket& rays, bool occluded[RayPacket::kSize]) const;
+    void occluders(const RayPacket& rays, OccluderSpan spans[RayPacket::kSize]) const;
+
 private:
+    void fillHit(const Vec3f& org, const Vec3f& dir, float t, unsigned geomID, unsigned primID, const Vec3f& ng,
+                 Hit& hit) const;
+
     struct GeometryInfo {
         const uint32_t* materialIds = nullptr;  // per primitive, or null with a constant material
         const uint32_t* shapeIds = nullptr;     // per primitive: object = object + shapeIds[prim]
