@@ -21,13 +21,13 @@ build: configure
 demo: build
 	@mkdir -p out
 	$(BUILD)/wedge render cornell --method maaf -o out/demo.exr -o out/demo.png --stats out/demo-stats.json
-	@$(BUILD)/wedge stats-summary out/demo-stats.json
 
 test: build
 	@cd $(BUILD) && ctest --output-on-failure -j $(JOBS)
 
 bench: build
 	$(BUILD)/bench/wedge_bench --benchmark_counters_tabular=true
+	WEDGE_EXTRAS=1 scripts/install-deps.sh && bench/pathtracer_peer.sh $(BUILD)
 
 clean:
 	rm -rf $(BUILD) out
