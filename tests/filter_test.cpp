@@ -191,7 +191,7 @@ TEST(MaafFilter, SeparableAccumulationEqualsDirectEq22) {
     o.pairs = pairs;
     o.maxRadius = 20;  // the whole tiny image is inside every window
     o.symmetricOuter = false;
-    MaafAccumulator acc(W, H, pairs, 3);
+    MaafAccumulator acc(pimg, pairs, 3);
     struct Smp {
         float y[2], u[2];
         Vec3f f;
@@ -242,7 +242,7 @@ TEST(MaafFilter, ConstantSignalStaysConstantAndNoNan) {
     Image<MaafPixel> pimg(W, H, params);
     MaafOptions o;
     o.pairs = pairs;
-    MaafAccumulator acc(W, H, pairs, 1);
+    MaafAccumulator acc(pimg, pairs, 1);
     for (size_t p = 0; p < size_t(W * H); ++p) {
         if (p % 11 == 0) continue;  // pixels without samples
         for (int s = 0; s < 4; ++s) {

@@ -125,6 +125,70 @@ MaafParams maafParams(const FrameBuffers& fb, const WedgeField& wf, const Filter
     return mp;
 }
 
+namespace {
+
+uint16_t toUnorm16(float v) { return uint16_t(std::clamp(v, 0.f, 1.f) * 65535.f + 0.5f); }
+float fromUnorm16(uint16_t v) { return float(v) * (1.f / 65535.f); }
+
+/// Octahedral map of a unit vector to [0, 1]^2 (Cigolle et al. 2014) and back.
+Vec2f octEncode(const Vec3f& v) {
+    float l1 = std::abs(v.x) + std::abs(v.y) + std::abs(v.z);
+    if (l1 <= 0) return {0.5f, 0.5f};
+    float x = v.x / l1, y = v.y / l1;
+    if (v.z < 0) {
+        float ox = (1.f - std::abs(y)) * (x >= 0 ? 1.f : -1.f);
+        float oy = (1.f - std::abs(x)) * (y >= 0 ? 1.f : -1.f);
+        x = ox;
+        y = oy;
+    }
+    return {0.5f * x + 0.5f, 0.5f * y + 0.5f};
+}
+Vec3f octDecode(float u, float v) {
+    float x = 2.f * u - 1.f, y = 2.f * v - 1.f, z = 1.f - std::abs(x) - std::abs(y);
+    if (z < 0) {
+        float ox = (1.f - std::abs(y)) * (x >= 0 ? 1.f : -1.f);
+        float oy = (1.f - std::abs(x)) * (y >= 0 ? 1.f : -1.f);
+        x = ox;
+        y = oy;
+    }
+    return normalize(Vec3f(x, y, z));
+}
+
+}  // namespace
+
+MaafSample MaafSample::pack(const SampleRecord& r, const ViewGeometry& view, int slot) {
+    MaafSample m;
+    m.indirect = r.indirect;
+    const ViewGeometry::Light& l = view.lights[r.light];
+    Vec3f rel = r.lightPoint - l.center;
+    m.lightA = dot(rel, l.axisA);
+    m.lightB = dot(rel, l.axisB);
+    m.unoccluded = r.unoccluded;
+    m.lens[0] = toUnorm16(0.5f * r.lens.x + 0.5f);
+    m.lens[1] = toUnorm16(0.5f * r.lens.y + 0.5f);
+    bool bounced = lengthSquared(r.bounceDir) > 0;
+    Vec2f o = bounced ? octEncode(r.bounceDir) : Vec2f{0.5f, 0.5f};
+    m.bounce[0] = toUnorm16(o.x);
+    m.bounce[1] = toUnorm16(o.y);
+    m.light = uint8_t(r.light);
+    m.visible = uint8_t((luminance(r.direct) > 0 ? 1 : 0) | (bounced ? 2 : 0));
+    m.slot = int8_t(slot);
+    return m;
+}
+
+SampleRecord MaafSample::unpack(const ViewGeometry& view) const {
+    SampleRecord r;
+    const ViewGeometry::Light& l = view.lights[light];
+    r.light = light;
+    r.lightPoint = l.center + l.axisA * lightA + l.axisB * lightB;
+    r.unoccluded = unoccluded;
+    r.direct = Vec3f((visible & 1) ? unoccluded : 0.f);  // luminance only: MAAF filters visibility
+    r.indirect = indirect;
+    r.lens = {2.f * fromUnorm16(lens[0]) - 1.f, 2.f * fromUnorm16(lens[1]) - 1.f};
+    r.bounceDir = (visible & 2) ? octDecode(fromUnorm16(bounce[0]), fromUnorm16(bounce[1])) : Vec3f(0.f);
+    return r;
+}
+
 void directCoordinates(const SampleRecord& s, const AxisFrame& frame, const ViewGeometry& view, float y[2], float u[2]) {
     Vec3f rel = s.lightPoint - view.lights[s.light].center;
     y[0] = dot(rel, frame.axis[0]);
@@ -140,9 +204,27 @@ void indirectCoordinates(const SampleRecord& s, const AxisFrame& frame, float y[
     u[1] = -s.lens.y;
 }
 
-MaafAccumulator::MaafAccumulator(int width, int height, int pairs, int values)
-    : m_width(width), m_height(height), m_pairs(pairs), m_bands(2 * pairs - 1), m_values(values), m_channels(values + 1),
-      m_stride(size_t(m_bands) * m_bands * m_channels), m_data(size_t(width) * height * m_stride, 0.f) {}
+MaafAccumulator::MaafAccumulator(const Image<MaafPixel>& params, int pairs, int values)
+    : m_width(params.width()), m_height(params.height()), m_pairs(pairs), m_maxBands(2 * pairs - 1), m_values(values),
+      m_channels(values + 1) {
+    const size_t n = params.size();
+    m_bands1.resize(n);
+    m_bands2.resize(n);
+    m_offset.resize(n + 1);
+    size_t total = 0;
+    for (size_t p = 0; p < n; ++p) {
+        m_bands1[p] = uint8_t(2 * std::min(params[p].axis[0].pairs, pairs) - 1);
+        m_bands2[p] = uint8_t(2 * std::min(params[p].axis[1].pairs, pairs) - 1);
+        m_offset[p] = total;
+        total += size_t(m_bands1[p]) * m_bands2[p] * size_t(m_channels);
+    }
+    m_offset[n] = total;
+    m_data.resize(total);
+    parallelRows(m_height, [&](int y) {
+        size_t a = m_offset[size_t(y) * m_width], b = m_offset[size_t(y + 1) * m_width];
+        std::fill(m_data.begin() + a, m_data.begin() + b, 0.f);
+    });
+}
 
 void MaafAccumulator::add(size_t pixel, const float* value, float weight, const float y[2], const float u[2],
                           const MaafPixel& params) {
@@ -167,13 +249,13 @@ void MaafAccumulator::add(size_t pixel, const float* value, float weight, const 
             }
         }
     }
-    float* d = &m_data[pixel * m_stride];
-    const int C = m_channels, V = m_values;
+    float* d = &m_data[m_offset[pixel]];
+    const int C = m_channels, V = m_values, b2 = m_bands2[pixel];
     for (int i = 0; i < used[0]; ++i) {
         if (A[0][i] == 0.f) continue;
         for (int j = 0; j < used[1]; ++j) {
             float t = A[0][i] * A[1][j] * weight;
-            float* e = d + C * (i * m_bands + j);
+            float* e = d + C * (i * b2 + j);
             for (int c = 0; c < V; ++c) e[c] += value[c] * t;
             e[V] += t;
         }
@@ -181,8 +263,7 @@ void MaafAccumulator::add(size_t pixel, const float* value, float weight, const 
 }
 
 void MaafAccumulator::scale(size_t pixel, float s) {
-    float* d = &m_data[pixel * m_stride];
-    for (size_t i = 0; i < m_stride; ++i) d[i] *= s;
+    for (size_t i = m_offset[pixel]; i < m_offset[pixel + 1]; ++i) m_data[i] *= s;
 }
 
 namespace {
@@ -217,7 +298,7 @@ bool neighbour(const FrameBuffers& fb, const Image<MaafPixel>& params, const Axi
 
 Image3f MaafAccumulator::filter(const Image<MaafPixel>& params, const FrameBuffers& fb, const Image<AxisFrame>& frames,
                                 const Image3f& fallback, const MaafOptions& o) const {
-    const int W = m_width, H = m_height, B = m_bands, C = m_channels, V = m_values;
+    const int W = m_width, H = m_height, B = m_maxBands, C = m_channels, V = m_values;
     const size_t istride = size_t(B + 1) * C;  // B bands of axis 2, plus the central-only band
     LargeVector<float> inter(size_t(W) * H * istride, 0.f);
 
@@ -246,17 +327,21 @@ Image3f MaafAccumulator::filter(const Image<MaafPixel>& params, const FrameBuffe
                 size_t q = size_t(y) * W + x + k;
                 float a = av[k + radius], r = rv[k + radius];
                 const float* T = pixel(q);
+                const int nq = (m_bands1[q] + 1) / 2, bq2 = m_bands2[q];  // the neighbour's own bands
                 for (int c = 0; c < (mirror ? ax.pairs : 1); ++c) {
+                    if (c >= nq) break;  // the neighbour accumulated no such component
                     float sr = ax.sx[c] * r;
                     float g = ax.weight[c] * ax.sx[c] * kInvSqrt2Pi * std::exp(-0.5f * sr * sr);
                     if (c == 0) {
-                        for (int j = 0; j < B * C; ++j) out[j] += g * T[j];
+                        for (int j = 0; j < bq2 * C; ++j) out[j] += g * T[j];
                         for (int j = 0; j < C; ++j) out[B * C + j] += g * T[j];
                     } else {
-                        float gc = g * std::cos(ax.cx[c] * a), gs = g * std::sin(ax.cx[c] * a);
-                        const float* Tc = T + (2 * c - 1) * B * C;
-                        const float* Ts = T + (2 * c) * B * C;
-                        for (int j = 0; j < B * C; ++j) out[j] += gc * Tc[j] + gs * Ts[j];
+                        float sn, cs;
+                        sincosf(ax.cx[c] * a, &sn, &cs);
+                        float gc = g * cs, gs = g * sn;
+                        const float* Tc = T + (2 * c - 1) * bq2 * C;
+                        const float* Ts = T + (2 * c) * bq2 * C;
+                        for (int j = 0; j < bq2 * C; ++j) out[j] += gc * Tc[j] + gs * Ts[j];
                     }
                 }
             }

@@ -101,24 +101,27 @@ MaafParams maafParams(const FrameBuffers& fb, const WedgeField& wedges, const Fi
                       const ViewGeometry& view, const MaafOptions& options);
 
 /// Per-pixel accumulations of eq. 23 for one effect, (2N-1)^2 bands x (values..., weight).
-/// Indirect light accumulates rgb with weight 1; direct light accumulates the visible
-/// luminance with the unoccluded luminance as weight, so that the filtered ratio is the
-/// visibility (multiplied afterwards by the closed-form unoccluded irradiance).
+/// Indirect light accumulates rgb with weight 1; direct light accumulates the visibility with
+/// the unoccluded luminance as weight, so that the filtered ratio is the visibility (multiplied
+/// afterwards by the closed-form unoccluded irradiance). Each pixel stores only the bands its
+/// own components use ((2 N_1 - 1) x (2 N_2 - 1)), so memory and work follow the wedge.
 class MaafAccumulator {
 public:
-    MaafAccumulator(int width, int height, int pairs, int values);
+    MaafAccumulator(const Image<MaafPixel>& params, int pairs, int values);
+    /// Upper bound of the memory for every pixel using all components (for the memory check).
     static size_t bytes(int width, int height, int pairs, int values) {
         return size_t(width) * height * size_t(sqr(2 * pairs - 1)) * size_t(values + 1) * sizeof(float);
     }
-    int bands() const { return m_bands; }
+    size_t allocatedBytes() const { return m_data.size() * sizeof(float) + m_offset.size() * sizeof(size_t); }
 
     /// Adds one sample: `value` (m_values floats) with weight `weight` (the filter returns the
-    /// weighted mean of the values), secondary coordinates
-    /// y[2] and lens coordinates u[2] (per axis). Not synchronised: one thread per pixel.
+    /// weighted mean of the values), secondary coordinates y[2] and lens coordinates u[2] (per
+    /// axis). `params` must be the pixel's own. Not synchronised: one thread per pixel.
     void add(size_t pixel, const float* value, float weight, const float y[2], const float u[2], const MaafPixel& params);
     /// Divides a pixel's accumulations by its sample count (per-pixel means).
     void scale(size_t pixel, float s);
-    const float* pixel(size_t p) const { return &m_data[p * m_stride]; }
+    const float* pixel(size_t p) const { return &m_data[m_offset[p]]; }
+    int bands(size_t p, int axis) const { return axis == 0 ? m_bands1[p] : m_bands2[p]; }
 
     /// Eq. 21 on image x then image y: the filtered values divided by the filtered weight (one
     /// value channel is replicated to rgb). Pixels without a surface or weight keep `fallback`.
@@ -126,10 +129,30 @@ public:
                    const Image3f& fallback, const MaafOptions& options) const;
 
 private:
-    int m_width, m_height, m_pairs, m_bands, m_values, m_channels;
-    size_t m_stride;
+    int m_width, m_height, m_pairs, m_maxBands, m_values, m_channels;
+    LargeVector<uint8_t> m_bands1, m_bands2;
+    LargeVector<size_t> m_offset;
     LargeVector<float> m_data;
 };
+
+/// An initial sample as MAAF holds it until the pixel's components are known (after the slope
+/// prefilter), then accumulates and frees it: 36 bytes instead of the 64 of a SampleRecord.
+/// The filter never sees samples; only the accumulations reach it.
+struct MaafSample {
+    Vec3f indirect;        // demodulated one-bounce radiance
+    float lightA, lightB;  // light point relative to the light's centre, along its axes A and B
+    float unoccluded;      // the direct sample's luminance without visibility (0: light behind)
+    uint16_t lens[2];      // lens position, unorm16 of (l + 1) / 2
+    uint16_t bounce[2];    // bounce direction, octahedral, unorm16
+    uint8_t light = 0, visible = 0;
+    int8_t slot = -1;      // the pixel's surface slot (PixelStats) the sample went to
+    uint8_t pad = 0;
+
+    static MaafSample pack(const SampleRecord& r, const ViewGeometry& view, int slot);
+    /// The record again (direct as visibility x unoccluded luminance, which is all MAAF uses).
+    SampleRecord unpack(const ViewGeometry& view) const;
+};
+static_assert(sizeof(MaafSample) == 36);
 
 /// The secondary and lens coordinates of a sample along a pixel's two axes.
 void directCoordinates(const SampleRecord& s, const AxisFrame& frame, const ViewGeometry& view, float y[2], float u[2]);

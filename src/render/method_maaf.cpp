@@ -1,5 +1,6 @@
 // --method maaf: multiple axis-aligned filters (filter/maaf.h) as in Sec. 6.2 of the paper.
-// Stages: initial sampling (16 path samples per pixel with occluder spans, kept as records);
+// Stages: initial sampling (16 path samples per pixel with occluder spans, held in a compact
+// form until they are accumulated);
 // prefilter: slopes over a 5x5 window, components per pixel, then the accumulation of eq. 23
 // over each pixel's samples; adaptive sampling only where the wedge degenerates at the focal
 // plane (central filter, AAF rates, at most 100 more samples); filter: eq. 21 on both image
@@ -52,7 +53,7 @@ void renderMaaf(const MethodContext& ctx, RenderResult& result) {
     // parameters. Refuse before allocating more than the machine has.
     const size_t pixels = size_t(W) * H;
     const size_t accBytes = filter::MaafAccumulator::bytes(W, H, mo.pairs, 1) + filter::MaafAccumulator::bytes(W, H, mo.pairs, 3);
-    const size_t recordBytes = pixels * n0 * (sizeof(SampleRecord) + 1);
+    const size_t recordBytes = pixels * n0 * sizeof(filter::MaafSample);
     const size_t otherBytes = pixels * (2 * sizeof(filter::MaafPixel) + sizeof(PixelStats) +
                                         size_t(2 * mo.pairs) * 4 * sizeof(float) + 256);
     const size_t need = accBytes + recordBytes + otherBytes;
@@ -63,13 +64,12 @@ void renderMaaf(const MethodContext& ctx, RenderResult& result) {
                                          " components and " + std::to_string(n0) + " initial spp, but only " +
                                          std::to_string(avail >> 20) + " MiB are available");
     result.extra.emplace_back("maaf_components", double(2 * mo.pairs - 1));
-    result.extra.emplace_back("maaf_accumulator_bytes", double(accBytes));
+    result.extra.emplace_back("maaf_accumulator_bytes_bound", double(accBytes));
     result.extra.emplace_back("maaf_sample_record_bytes", double(recordBytes));
 
     Image<PixelStats> stats(W, H);
     FrameBuffers& fb = result.buffers;
-    LargeVector<SampleRecord> records(pixels * n0);
-    LargeVector<int8_t> slots(pixels * n0, -1);
+    LargeVector<filter::MaafSample> records(pixels * n0);
 
     // 1. Initial sampling: 16 path samples with occluder spans; keep the records.
     Timer t;
@@ -81,8 +81,7 @@ void renderMaaf(const MethodContext& ctx, RenderResult& result) {
             [&](int x, int y, const TracedSample& s, int slot) {
                 size_t p = size_t(y) * W + x;
                 size_t i = p * n0 + fill[p]++;
-                records[i] = s.record;
-                slots[i] = int8_t(slot);
+                records[i] = filter::MaafSample::pack(s.record, view, slot);
             },
             &progress);
     }
@@ -112,7 +111,8 @@ void renderMaaf(const MethodContext& ctx, RenderResult& result) {
 
     // 2b. Accumulation of eq. 23 over the initial samples on each pixel's primary surface.
     t.reset();
-    filter::MaafAccumulator accDirect(W, H, mo.pairs, 1), accIndirect(W, H, mo.pairs, 3);
+    filter::MaafAccumulator accDirect(params.direct, mo.pairs, 1), accIndirect(params.indirect, mo.pairs, 3);
+    result.extra.emplace_back("maaf_accumulator_bytes", double(accDirect.allocatedBytes() + accIndirect.allocatedBytes()));
     std::vector<uint32_t> counted(pixels, 0);
     auto accumulate = [&](size_t p, const SampleRecord& r) {
         float y[2], u[2];
@@ -128,7 +128,7 @@ void renderMaaf(const MethodContext& ctx, RenderResult& result) {
             size_t p = size_t(y) * W + x;
             int primary = stats[p].primary();
             for (uint32_t i = 0; i < n0; ++i)
-                if (slots[p * n0 + i] == primary) accumulate(p, records[p * n0 + i]);
+                if (records[p * n0 + i].slot == primary) accumulate(p, records[p * n0 + i].unpack(view));
         }
     });
     records.clear();
