@@ -1,5 +1,7 @@
 #include "render/path_sampler.h"
 
+#include <algorithm>
+
 namespace wedge::render {
 
 PathSampler::PathSampler(const scene::Scene& scene, const Camera& camera, bool indirect, uint32_t seed)
@@ -70,21 +72,29 @@ void PathSampler::traceBatch(int x, int y, uint32_t first, uint32_t count, bool 
         Vec3f normal[K];
         LightSample ls[K], l2[K];
 
+        // The batch's random numbers, pair by pair (vectorised across samples). Dimensions that
+        // do not matter are not drawn (the others do not depend on it).
+        const uint32_t first16 = first + base;
+        Vec2f uPix[K], uLens[K], uChoice[K], uLight[K], uBounce[K], uBounceLight[K];
+        rng.get2DBatch(first16, uint32_t(n), kPixel, uPix);
+        if (m_camera.hasLens()) rng.get2DBatch(first16, uint32_t(n), kLens, uLens);
+        if (m_needChoice) rng.get2DBatch(first16, uint32_t(n), kChoice, uChoice);
+        else std::fill(uChoice, uChoice + n, Vec2f{0, 0});
+        rng.get2DBatch(first16, uint32_t(n), kLight, uLight);
+        if (m_indirect) {
+            rng.get2DBatch(first16, uint32_t(n), kBounce, uBounce);
+            rng.get2DBatch(first16, uint32_t(n), kBounceLight, uBounceLight);
+        }
+
         // Primary rays through the lens.
         scene::RayPacket primary;
         for (int k = 0; k < n; ++k) {
-            uint32_t index = first + base + uint32_t(k);
             out[k] = TracedSample();
-            Vec2f pix = rng.get2D(index, kPixel);
-            // Dimensions only drawn where they matter (the values do not depend on it).
-            Vec2f c = m_needChoice ? rng.get2D(index, kChoice) : Vec2f{0, 0};
-            choice[k] = c.x;
-            time[k] = c.y;
+            Vec2f pix = uPix[k];
+            choice[k] = uChoice[k].x;
+            time[k] = uChoice[k].y;
             Vec2f lens{0, 0};
-            if (m_camera.hasLens()) {
-                Vec2f lensU = rng.get2D(index, kLens);
-                lens = concentricDisc(lensU.x, lensU.y);
-            }
+            if (m_camera.hasLens()) lens = concentricDisc(uLens[k].x, uLens[k].y);
             out[k].record.lens = lens;
             Ray ray = m_camera.generate(float(x) + pix.x, float(y) + pix.y, lens);
             primary.set(k, ray.origin, ray.direction, kInf, time[k]);
@@ -98,7 +108,6 @@ void PathSampler::traceBatch(int x, int y, uint32_t first, uint32_t count, bool 
         scene::RayPacket shadow;
         for (int k = 0; k < n; ++k) {
             if (!found[k]) continue;
-            uint32_t index = first + base + uint32_t(k);
             mat[k] = &m_scene.material(hit[k].material);
             bool front = dot(hit[k].normal, primary.dir[k]) < 0;
             normal[k] = front ? hit[k].normal : -hit[k].normal;  // two-sided shading
@@ -110,7 +119,7 @@ void PathSampler::traceBatch(int x, int y, uint32_t first, uint32_t count, bool 
             o.depth = m_camera.depth(hit[k].position);
             o.object = hit[k].object;
             if (front) o.emission = mat[k]->emission;  // emitters shine from their front side
-            ls[k] = sampleLight(hit[k].position, normal[k], rng.get2D(index, kLight), choice[k]);
+            ls[k] = sampleLight(hit[k].position, normal[k], uLight[k], choice[k]);
             o.record.light = ls[k].light;
             o.record.lightPoint = ls[k].point;
             if (maxComponent(ls[k].irradiance) <= 0) continue;
@@ -146,8 +155,7 @@ void PathSampler::traceBatch(int x, int y, uint32_t first, uint32_t count, bool 
         scene::RayPacket bounce;
         for (int k = 0; k < n; ++k) {
             if (!found[k] || maxComponent(mat[k]->albedo) <= 0) continue;
-            Vec2f ub = rng.get2D(first + base + uint32_t(k), kBounce);
-            Vec3f dir = Frame(normal[k]).toWorld(cosineHemisphere(ub.x, ub.y));
+            Vec3f dir = Frame(normal[k]).toWorld(cosineHemisphere(uBounce[k].x, uBounce[k].y));
             out[k].record.bounceDir = dir;
             bounce.set(k, offset(hit[k].position, normal[k]), dir, kInf, time[k]);
             ++out[k].rays;
@@ -167,7 +175,7 @@ void PathSampler::traceBatch(int x, int y, uint32_t first, uint32_t count, bool 
             m2[k] = &m_scene.material(h2[k].material);
             if (maxComponent(m2[k]->albedo) <= 0) continue;
             Vec3f n2 = dot(h2[k].normal, bounce.dir[k]) < 0 ? h2[k].normal : -h2[k].normal;
-            l2[k] = sampleLight(h2[k].position, n2, rng.get2D(first + base + uint32_t(k), kBounceLight), choice[k]);
+            l2[k] = sampleLight(h2[k].position, n2, uBounceLight[k], choice[k]);
             if (maxComponent(l2[k].irradiance) <= 0) continue;
             Vec3f org2 = offset(h2[k].position, n2);
             Vec3f toPoint = l2[k].point - org2;
