@@ -161,7 +161,7 @@ MaafPixel uniformParams(int pairs, bool lens) {
     w.suMax = 1.2;
     w.omegaUMax = 6;
     auto comps = maafComponents(pairs, w);
-    MaafPixel m;
+    MaafPixel m{};
     for (int k = 0; k < 2; ++k) {
         m.axis[k].pairs = pairs;
         for (const auto& c : comps) {

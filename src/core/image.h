@@ -5,6 +5,7 @@
 #include <cassert>
 #include <cstddef>
 #include <algorithm>
+#include <type_traits>
 #include <vector>
 
 #include "core/math.h"
@@ -15,10 +16,18 @@
 
 namespace wedge {
 
+/// Tag: allocate an image without writing it (for trivially constructible T that the caller
+/// writes entirely, so that the pages are first touched by that write).
+struct NoInit {};
+
 template <class T>
 class Image {
 public:
     Image() = default;
+    Image(int width, int height, NoInit) : m_width(width), m_height(height) {
+        static_assert(std::is_trivially_default_constructible_v<T>);
+        m_data.resize(size_t(width) * height);
+    }
     Image(int width, int height, const T& fill = T{}) : m_width(width), m_height(height) {
         // Default-initialised storage filled in parallel: the first touch of the pages (and the
         // kernel's zeroing of them) is spread over the worker threads.

@@ -23,7 +23,7 @@ struct AxisInputs {
 
 MaafAxis buildAxis(const AxisInputs& in, const MaafOptions& o) {
     const int pairs = o.pairs, maxRadius = o.maxRadius;
-    MaafAxis ax;
+    MaafAxis ax{};
     const float sxFloor = float(1.0 / (maxRadius * in.step));  // primal std of maxRadius pixels
     if (!in.yWedge) {
         // No wedge (no occluder, no bounce hit): the signal is smooth; the widest filter.
@@ -84,14 +84,19 @@ MaafAxis buildAxis(const AxisInputs& in, const MaafOptions& o) {
 MaafParams maafParams(const FrameBuffers& fb, const WedgeField& wf, const FilterFrames& frames, const ViewGeometry& view,
                       const MaafOptions& o) {
     const int W = fb.width, H = fb.height;
-    MaafParams mp{Image<MaafPixel>(W, H), Image<MaafPixel>(W, H), Image1f(W, H)};
+    MaafParams mp{Image<MaafPixel>(W, H, NoInit{}), Image<MaafPixel>(W, H, NoInit{}), Image1f(W, H)};
     float sigma = kInf;
     for (auto& l : view.lights) sigma = std::min(sigma, l.sigma);
     const bool lens = view.apertureRadius > 0;
     parallelRows(H, [&](int y) {
         for (int x = 0; x < W; ++x) {
             size_t p = size_t(y) * W + x;
-            if (fb.object[p] < 0) continue;
+            if (fb.object[p] < 0) {
+                mp.direct[p] = MaafPixel{};
+                mp.indirect[p] = MaafPixel{};
+                for (int k = 0; k < 2; ++k) mp.direct[p].axis[k].pairs = mp.indirect[p].axis[k].pairs = 1;
+                continue;
+            }
             bool fallback = o.focalFallback && lens &&
                             (wf.focalStraddle[p] > 0 || (wf.suMin[p] < 0 && wf.suMax[p] > 0));
             mp.fallback[p] = fallback ? 1.f : 0.f;

@@ -61,11 +61,13 @@ namespace wedge::filter {
 
 constexpr int kMaafMaxPairs = 4;  // 7 components
 
+/// Trivially constructible (value-initialise with {} for zeros), so that the per-pixel images
+/// of parameters are first written where they are computed.
 struct MaafAxis {
-    int pairs = 1;  // components in use on this axis (1 = central only)
-    float cx[kMaafMaxPairs] = {}, sx[kMaafMaxPairs] = {}, weight[kMaafMaxPairs] = {};  // weight = c_p mu_p
-    float cy[kMaafMaxPairs] = {}, sy[kMaafMaxPairs] = {};
-    float cu[kMaafMaxPairs] = {}, su[kMaafMaxPairs] = {};
+    int pairs;  // components in use on this axis (1 = central only)
+    float cx[kMaafMaxPairs], sx[kMaafMaxPairs], weight[kMaafMaxPairs];  // weight = c_p mu_p
+    float cy[kMaafMaxPairs], sy[kMaafMaxPairs];
+    float cu[kMaafMaxPairs], su[kMaafMaxPairs];
 };
 struct MaafPixel {
     MaafAxis axis[2];
