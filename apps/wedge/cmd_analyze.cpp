@@ -12,7 +12,7 @@
 
 #include "analysis/coverage.h"
 #include "analysis/flatland.h"
-#include "analysis/plot.h"
+#include "io/plot.h"
 #include "analysis/tables.h"
 #include "apps/wedge/commands.h"
 #include "core/error.h"

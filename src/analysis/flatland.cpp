@@ -9,10 +9,18 @@
 #include <cstdio>
 #include <mutex>
 
-#include "analysis/plot.h"
+#include "io/plot.h"
 #include "core/error.h"
 
 namespace wedge::analysis {
+
+using io::besideEachOther;
+using io::Canvas;
+using io::displayColor;
+using io::LinePlot;
+using io::PlotSeries;
+using io::rampColor;
+using io::renderPlot;
 
 namespace {
 

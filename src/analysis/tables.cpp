@@ -11,12 +11,20 @@
 #include <tuple>
 #include <unistd.h>
 
-#include "analysis/plot.h"
+#include "io/plot.h"
 #include "core/error.h"
 #include "filter/maaf_components.h"
 #include "io/image_io.h"
 
 namespace wedge::analysis {
+
+using io::besideEachOther;
+using io::Canvas;
+using io::displayColor;
+using io::LinePlot;
+using io::PlotSeries;
+using io::rampColor;
+using io::renderPlot;
 
 namespace {
 

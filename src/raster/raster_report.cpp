@@ -1,10 +1,11 @@
 // JSON stats, the sweep's CSV and JSON, and its plot (Vaidyanathan et al. 2012, Fig. 8).
 #include "raster/raster_report.h"
 
+#include <algorithm>
 #include <cstdio>
 #include <sstream>
 
-#include "raster/plot.h"
+#include "io/plot.h"
 
 namespace wedge::raster {
 
@@ -95,31 +96,40 @@ nlohmann::json sweepJson(const SweepResult& sweep, const std::string& sceneName)
 }
 
 Image3f sweepPlot(const SweepResult& sweep, const std::string& sceneName) {
-    PlotSpec spec;
+    io::LinePlot plot;
     std::string name = sceneName;
     if (auto slash = name.find_last_of('/'); slash != std::string::npos) name = name.substr(slash + 1);
-    spec.title = "SHADED QUADS VS CACHE SIZE: " + name;
-    spec.xLabel = "CACHE ENTRIES";
-    spec.yLabel = "SHADED QUADS";
-    const Vec3f blue(0.12f, 0.35f, 0.75f), orange(0.90f, 0.45f, 0.05f);
-    PlotSeries ds{"DS", blue, {}, {}}, aas{"AAS", orange, {}, {}};
-    PlotSeries dsInf{"DS, UNBOUNDED CACHE", blue * 0.7f + Vec3f(0.3f), {}, {}, true};
-    PlotSeries aasInf{"AAS, UNBOUNDED CACHE", orange * 0.7f + Vec3f(0.3f), {}, {}, true};
+    plot.title = "SHADED QUADS VS CACHE SIZE: " + name;
+    plot.xLabel = "CACHE ENTRIES";
+    plot.yLabel = "SHADED QUADS";
+    plot.logX = plot.logY = true;
+    const Vec3f blue = io::displayColor(0.12f, 0.35f, 0.75f), orange = io::displayColor(0.90f, 0.45f, 0.05f);
+    io::PlotSeries ds{"DS", {}, {}, blue, true, 0}, aas{"AAS", {}, {}, orange, true, 2};
+    io::PlotSeries dsInf{"DS, UNBOUNDED CACHE", {}, {}, blue * 0.7f + Vec3f(0.3f), true, -1, 6};
+    io::PlotSeries aasInf{"AAS, UNBOUNDED CACHE", {}, {}, orange * 0.7f + Vec3f(0.3f), true, -1, 6};
+    double yLo = kInf, yHi = 0;
     for (const SweepRow& r : sweep.rows) {
         double k = double(r.cacheEntries);
-        ds.x.push_back(k);
-        ds.y.push_back(double(r.ds.shadedQuads));
-        aas.x.push_back(k);
-        aas.y.push_back(double(r.aas.shadedQuads));
+        ds.xs.push_back(k);
+        ds.ys.push_back(double(r.ds.shadedQuads));
+        aas.xs.push_back(k);
+        aas.ys.push_back(double(r.aas.shadedQuads));
+        plot.xTicks.push_back(k);
+        yLo = std::min({yLo, double(r.ds.shadedQuads), double(r.aas.shadedQuads)});
+        yHi = std::max({yHi, double(r.ds.shadedQuads), double(r.aas.shadedQuads)});
     }
-    if (!sweep.rows.empty()) {
-        double k0 = double(sweep.rows.front().cacheEntries), k1 = double(sweep.rows.back().cacheEntries);
-        dsInf.x = aasInf.x = {std::min(k0, k1), std::max(k0, k1)};
-        dsInf.y = {double(sweep.ds.quadsUnboundedCache), double(sweep.ds.quadsUnboundedCache)};
-        aasInf.y = {double(sweep.aas.quadsUnboundedCache), double(sweep.aas.quadsUnboundedCache)};
-    }
-    spec.series = {ds, aas, dsInf, aasInf};
-    return drawLinePlot(spec);
+    if (sweep.rows.empty()) return io::renderPlot(plot, 760, 500);
+    double k0 = double(sweep.rows.front().cacheEntries), k1 = double(sweep.rows.back().cacheEntries);
+    plot.xMin = std::min(k0, k1) / 1.3;
+    plot.xMax = std::max(k0, k1) * 1.3;
+    dsInf.xs = aasInf.xs = {plot.xMin, plot.xMax};
+    dsInf.ys = {double(sweep.ds.quadsUnboundedCache), double(sweep.ds.quadsUnboundedCache)};
+    aasInf.ys = {double(sweep.aas.quadsUnboundedCache), double(sweep.aas.quadsUnboundedCache)};
+    yLo = std::min({yLo, dsInf.ys[0], aasInf.ys[0]});
+    plot.yMin = std::max(1.0, yLo / 1.5);
+    plot.yMax = yHi * 1.5;
+    plot.series = {ds, aas, dsInf, aasInf};
+    return io::renderPlot(plot, 760, 500);
 }
 
 }  // namespace wedge::raster

@@ -1,6 +1,6 @@
 // Raster plotting for the analysis figures: canvas primitives, a 5x7 bitmap font (the classic
 // HD44780 character shapes) and line plots.
-#include "analysis/plot.h"
+#include "io/plot.h"
 
 #include <algorithm>
 #include <cctype>
@@ -9,7 +9,7 @@
 
 #include "io/image_io.h"
 
-namespace wedge::analysis {
+namespace wedge::io {
 
 namespace {
 
@@ -157,18 +157,23 @@ Image3f renderPlot(const LinePlot& plot, int width, int height) {
                              : (x - plot.xMin) / (plot.xMax - plot.xMin);
         return left + t * pw;
     };
-    auto mapY = [&](double y) { return top + ph - (y - plot.yMin) / (plot.yMax - plot.yMin) * ph; };
+    auto mapY = [&](double y) {
+        double t = plot.logY ? (std::log(y) - std::log(plot.yMin)) / (std::log(plot.yMax) - std::log(plot.yMin))
+                             : (y - plot.yMin) / (plot.yMax - plot.yMin);
+        return top + ph - t * ph;
+    };
+    auto logTicks = [](double lo, double hi) {
+        std::vector<double> t;
+        for (double d = std::pow(10.0, std::floor(std::log10(lo))); d <= hi * 1.0001; d *= 10)
+            for (double m : {1.0, 2.0, 5.0})
+                if (m * d >= lo * 0.9999 && m * d <= hi * 1.0001) t.push_back(m * d);
+        return t;
+    };
 
     // Grid, ticks and tick labels.
     std::vector<double> xt = plot.xTicks;
     if (xt.empty()) {
-        if (plot.logX) {
-            for (double d = std::pow(10.0, std::floor(std::log10(plot.xMin))); d <= plot.xMax * 1.0001; d *= 10)
-                for (double m : {1.0, 2.0, 5.0})
-                    if (m * d >= plot.xMin * 0.9999 && m * d <= plot.xMax * 1.0001) xt.push_back(m * d);
-        } else {
-            xt = niceTicks(plot.xMin, plot.xMax, 8);
-        }
+        xt = plot.logX ? logTicks(plot.xMin, plot.xMax) : niceTicks(plot.xMin, plot.xMax, 8);
     }
     for (size_t i = 0; i < xt.size(); ++i) {
         double px = mapX(xt[i]);
@@ -176,7 +181,7 @@ Image3f renderPlot(const LinePlot& plot, int width, int height) {
         std::string label = i < plot.xTickLabels.size() ? plot.xTickLabels[i] : formatTick(xt[i]);
         cv.text(int(px) - Canvas::textWidth(label) / 2, top + ph + 8, label, black);
     }
-    for (double v : niceTicks(plot.yMin, plot.yMax, 6)) {
+    for (double v : plot.logY ? logTicks(plot.yMin, plot.yMax) : niceTicks(plot.yMin, plot.yMax, 6)) {
         double py = mapY(v);
         cv.line(left, py, left + pw, py, grey);
         std::string label = formatTick(v);
@@ -243,4 +248,4 @@ Image3f besideEachOther(const std::vector<Image3f>& images, int gap) {
     return out;
 }
 
-}  // namespace wedge::analysis
+}  // namespace wedge::io

@@ -1,7 +1,8 @@
-// Minimal raster plotting for the analysis figures (no plotting library): a canvas with lines,
-// markers and a built-in 5x7 bitmap font, and line plots with axes, ticks and a legend, drawn
-// into an Image3f of linear colours for io::writePng. Used by `wedge analyze` for the spectrum
-// figure and for Tables 1-2 / Fig. 6 of Wu et al. 2017.
+// Minimal raster plotting (no plotting library): a canvas with lines, markers and a built-in 5x7
+// bitmap font, and line plots with linear or logarithmic axes, ticks and a legend, drawn into an
+// Image3f of linear colours for writePng. Used by `wedge analyze` (the spectrum figure, Tables
+// 1-2 and Fig. 6 of Wu et al. 2017) and `wedge raster` (the cache sweep, Fig. 8 of Vaidyanathan
+// et al. 2012).
 #pragma once
 
 #include <string>
@@ -9,7 +10,7 @@
 
 #include "core/image.h"
 
-namespace wedge::analysis {
+namespace wedge::io {
 
 /// Display colour (sRGB components in [0, 1]) -> the linear value writePng expects.
 Vec3f displayColor(float r, float g, float b);
@@ -50,7 +51,7 @@ struct PlotSeries {
 struct LinePlot {
     std::string title, xLabel, yLabel;
     double xMin = 0, xMax = 1, yMin = 0, yMax = 1;
-    bool logX = false;
+    bool logX = false, logY = false;  // log axes (positive values only)
     std::vector<double> xTicks;                 // empty: automatic
     std::vector<std::string> xTickLabels;       // optional, one per xTick
     std::vector<PlotSeries> series;
@@ -61,4 +62,4 @@ Image3f renderPlot(const LinePlot& plot, int width = 800, int height = 520);
 /// Places images side by side (top-aligned) on a white background with a gap.
 Image3f besideEachOther(const std::vector<Image3f>& images, int gap = 16);
 
-}  // namespace wedge::analysis
+}  // namespace wedge::io
