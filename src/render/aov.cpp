@@ -20,4 +20,16 @@ void writeAov(const std::string& dir, const std::string& name, const Image1f& pl
     io::writePngHeat((std::filesystem::path(dir) / (name + ".png")).string(), plane, lo, hi);
 }
 
+void writeWedgeAovs(const std::string& dir, const std::string& prefix, const FrameBuffers& fb,
+                    const filter::WedgeField& wedges) {
+    Image1f s2(fb.width, fb.height);
+    for (size_t i = 0; i < s2.size(); ++i) s2[i] = wedges.s2[i] < kInf ? wedges.s2[i] : 0.f;
+    writeAov(dir, prefix + "_spp", fb.spp);
+    writeAov(dir, prefix + "_s1", wedges.s1);
+    writeAov(dir, prefix + "_s2", s2);
+    writeAov(dir, prefix + "_defocus_min", wedges.suMin);
+    writeAov(dir, prefix + "_defocus_max", wedges.suMax);
+    io::writePng((std::filesystem::path(dir) / (prefix + "_unfiltered.png")).string(), fb.color);
+}
+
 }  // namespace wedge::render

@@ -83,16 +83,9 @@ void renderAaf(const MethodContext& ctx, RenderResult& result) {
             beta[i] = fb.object[i] < 0 ? 0 : filter::aafRadiusPixels(params.omegaDirect[i], frames.direct[i].step[0], ao.maxRadius);
             betaInd[i] = fb.object[i] < 0 ? 0 : filter::aafRadiusPixels(params.omegaIndirect[i], frames.indirect[i].step[0], ao.maxRadius);
         }
-        Image1f s2(W, H);
-        for (size_t i = 0; i < s2.size(); ++i) s2[i] = wedges.s2[i] < kInf ? wedges.s2[i] : 0.f;
         writeAov(dir, "aaf_beta_direct", beta, 0, float(ao.maxRadius));
         writeAov(dir, "aaf_beta_indirect", betaInd, 0, float(ao.maxRadius));
-        writeAov(dir, "aaf_spp", fb.spp);
-        writeAov(dir, "aaf_s1", wedges.s1);
-        writeAov(dir, "aaf_s2", s2);
-        writeAov(dir, "aaf_defocus_min", wedges.suMin);
-        writeAov(dir, "aaf_defocus_max", wedges.suMax);
-        io::writePng(dir + "/aaf_unfiltered.png", fb.color);
+        writeWedgeAovs(dir, "aaf", fb, wedges);
     }
 }
 

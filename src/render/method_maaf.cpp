@@ -175,21 +175,17 @@ void renderMaaf(const MethodContext& ctx, RenderResult& result) {
 
     if (!ctx.options.aovDir.empty()) {
         const std::string& dir = ctx.options.aovDir;
-        Image1f width(W, H), s2(W, H);
+        Image1f width(W, H), components(W, H);
         for (size_t i = 0; i < pixels; ++i) {
             width[i] = fb.object[i] < 0 ? 0.f
                                         : std::min(float(mo.maxRadius),
                                                    1.f / (params.direct[i].axis[0].sx[0] * frames.direct[i].step[0]));
-            s2[i] = wedges.s2[i] < kInf ? wedges.s2[i] : 0.f;
+            components[i] = fb.object[i] < 0 ? 0.f : float(2 * params.direct[i].axis[0].pairs - 1);
         }
         writeAov(dir, "maaf_central_width_direct", width, 0, float(mo.maxRadius));
+        writeAov(dir, "maaf_components_direct", components, 0, float(2 * mo.pairs - 1));
         writeAov(dir, "maaf_fallback", params.fallback, 0, 1);
-        writeAov(dir, "maaf_spp", fb.spp);
-        writeAov(dir, "maaf_s1", wedges.s1);
-        writeAov(dir, "maaf_s2", s2);
-        writeAov(dir, "maaf_defocus_min", wedges.suMin);
-        writeAov(dir, "maaf_defocus_max", wedges.suMax);
-        io::writePng(dir + "/maaf_unfiltered.png", fb.color);
+        writeWedgeAovs(dir, "maaf", fb, wedges);
     }
 }
 
