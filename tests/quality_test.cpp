@@ -32,7 +32,8 @@ public:
         o.seed = 9999;
         m_reference = render::render(m_scene, o).color;
     }
-    Rendered run(const std::string& method, int spp, uint32_t seed, int maxExtra = -1) const {
+    Rendered run(const std::string& method, int spp, uint32_t seed,
+                 int maxExtra = render::RenderOptions::kDefaultMaxExtraSpp) const {
         render::RenderOptions o;
         o.quiet = true;
         o.method = method;

@@ -95,7 +95,7 @@ void registerExperiment(CLI::App& app) {
         ->check(CLI::NonNegativeNumber);
     cmd->add_option("--threads", args->threads, "Worker threads (0: all cores)")->check(CLI::NonNegativeNumber);
     render::RenderOptions& r = args->options.base;
-    cmd->add_option("--max-extra-spp", r.maxExtraSpp, "aaf/maaf: cap on adaptive samples per pixel")
+    cmd->add_option("--max-extra-spp", r.maxExtraSpp, "aaf/maaf: cap on adaptive samples per pixel (default 16; the papers use 100)")
         ->check(CLI::NonNegativeNumber);
     cmd->add_option("--maaf-components", r.maafComponents, "maaf: filters per 2D/3D subspace (3, 5 or 7)")
         ->check(CLI::IsMember({3, 5, 7}));

@@ -66,7 +66,7 @@ void registerRender(CLI::App& app) {
     cmd->add_option("--stats", args->stats, "Write timings and counts as JSON");
     cmd->add_option("--resolution", args->resolution, "Override the camera resolution, WxH");
     cmd->add_option("--aov", args->options.aovDir, "Write PNG debug maps (filter widths, spp, slopes) into this directory");
-    cmd->add_option("--max-extra-spp", args->options.maxExtraSpp, "aaf/maaf: cap on adaptive samples per pixel")
+    cmd->add_option("--max-extra-spp", args->options.maxExtraSpp, "aaf/maaf: cap on adaptive samples per pixel (default 16; the papers use 100)")
         ->check(CLI::Range(0, 1 << 16));
     cmd->add_option("--maaf-components", args->options.maafComponents, "maaf: filters per 2D/3D subspace (3, 5 or 7)")
         ->check(CLI::IsMember({3, 5, 7}));

@@ -41,7 +41,7 @@ void renderMaaf(const MethodContext& ctx, RenderResult& result) {
     const ViewGeometry& view = ctx.view;
     const int W = view.width, H = view.height;
     const uint32_t n0 = uint32_t(ctx.spp);
-    const int cap = ctx.options.maxExtraSpp >= 0 ? ctx.options.maxExtraSpp : 100;
+    const int cap = std::max(ctx.options.maxExtraSpp, 0);
     filter::MaafOptions mo;
     mo.pairs = (ctx.options.maafComponents + 1) / 2;
     mo.apertureWindows = ctx.options.maafWindows;

@@ -215,16 +215,46 @@ void Scene::occluded(const RayPacket& rays, bool occluded[RayPacket::kSize]) con
 }
 
 void Scene::occluders(const RayPacket& rays, OccluderSpan spans[RayPacket::kSize]) const {
-    SpanContext sc;
-    initSpan(sc);
+    // Two closest-hit queries instead of one traversal that visits every hit: the nearest
+    // occluder from the receiver, then, for the lanes that found one, the nearest occluder seen
+    // from the segment's far end (the light) looking back, which is the farthest one from the
+    // receiver. Closest-hit traversal culls by distance and needs no filter callback; measured
+    // on Sponza 512x512 (16 spp with spans) it is faster than the all-hits filter (README).
+    RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
     alignas(64) RTCRayHit16 rh;
     toRtc(rays, rh.ray);
     for (int i = 0; i < RayPacket::kSize; ++i) {
         rh.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
         rh.hit.instID[0][i] = RTC_INVALID_GEOMETRY_ID;
     }
-    rtcIntersect16(rays.valid, m_scene, &sc.context, &rh);
-    for (int i = 0; i < RayPacket::kSize; ++i) spans[i] = {rays.valid[i] && sc.any[i], sc.tNear[i], sc.tFar[i]};
+    rtcIntersect16(rays.valid, m_scene, &ctx, &rh);
+    alignas(64) int back[RayPacket::kSize];
+    bool anyBack = false;
+    for (int i = 0; i < RayPacket::kSize; ++i) {
+        bool hit = rays.valid[i] && rh.hit.geomID[i] != RTC_INVALID_GEOMETRY_ID;
+        spans[i] = hit ? OccluderSpan{true, rh.ray.tfar[i], rh.ray.tfar[i]} : OccluderSpan{};
+        back[i] = hit ? -1 : 0;
+        anyBack |= hit;
+    }
+    if (!anyBack) return;
+    RayPacket reverse;
+    for (int i = 0; i < RayPacket::kSize; ++i)
+        if (back[i]) {
+            // From the far end back to just past the nearest occluder, which it must find again
+            // at the latest (a small slack for the reversed ray's rounding).
+            float len = rays.tFar[i], slack = 1e-4f * len;
+            reverse.set(i, rays.org[i] + rays.dir[i] * len, -rays.dir[i], len - spans[i].tNear + slack, rays.time[i]);
+        }
+    toRtc(reverse, rh.ray);
+    for (int i = 0; i < RayPacket::kSize; ++i) {
+        rh.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
+        rh.hit.instID[0][i] = RTC_INVALID_GEOMETRY_ID;
+    }
+    rtcIntersect16(back, m_scene, &ctx, &rh);
+    for (int i = 0; i < RayPacket::kSize; ++i)
+        if (back[i] && rh.hit.geomID[i] != RTC_INVALID_GEOMETRY_ID)
+            spans[i].tFar = std::max(spans[i].tNear, rays.tFar[i] - rh.ray.tfar[i]);
 }
 
 bool Scene::occluded(const Vec3f& org, const Vec3f& dir, float tNear, float tFar, float time) const {
