@@ -163,7 +163,9 @@ Vec3f octDecode(float u, float v) {
 
 MaafSample MaafSample::pack(const SampleRecord& r, const ViewGeometry& view, int slot) {
     MaafSample m;
-    m.indirect = r.indirect;
+    m.indirect[0] = r.indirect.x;
+    m.indirect[1] = r.indirect.y;
+    m.indirect[2] = r.indirect.z;
     const ViewGeometry::Light& l = view.lights[r.light];
     Vec3f rel = r.lightPoint - l.center;
     m.lightA = dot(rel, l.axisA);
@@ -178,6 +180,7 @@ MaafSample MaafSample::pack(const SampleRecord& r, const ViewGeometry& view, int
     m.light = uint8_t(r.light);
     m.visible = uint8_t((luminance(r.direct) > 0 ? 1 : 0) | (bounced ? 2 : 0));
     m.slot = int8_t(slot);
+    m.pad = 0;
     return m;
 }
 
@@ -188,7 +191,7 @@ SampleRecord MaafSample::unpack(const ViewGeometry& view) const {
     r.lightPoint = l.center + l.axisA * lightA + l.axisB * lightB;
     r.unoccluded = unoccluded;
     r.direct = Vec3f((visible & 1) ? unoccluded : 0.f);  // luminance only: MAAF filters visibility
-    r.indirect = indirect;
+    r.indirect = Vec3f(indirect[0], indirect[1], indirect[2]);
     r.lens = {2.f * fromUnorm16(lens[0]) - 1.f, 2.f * fromUnorm16(lens[1]) - 1.f};
     r.bounceDir = (visible & 2) ? octDecode(fromUnorm16(bounce[0]), fromUnorm16(bounce[1])) : Vec3f(0.f);
     return r;
@@ -305,7 +308,10 @@ Image3f MaafAccumulator::filter(const Image<MaafPixel>& params, const FrameBuffe
                                 const Image3f& fallback, const MaafOptions& o) const {
     const int W = m_width, H = m_height, B = m_maxBands, C = m_channels, V = m_values;
     const size_t istride = size_t(B + 1) * C;  // B bands of axis 2, plus the central-only band
-    LargeVector<float> inter(size_t(W) * H * istride, 0.f);
+    LargeVector<float> inter(size_t(W) * H * istride);  // default-initialised: zeroed by the rows in parallel
+    parallelRows(H, [&](int y) {
+        std::fill(inter.begin() + size_t(y) * W * istride, inter.begin() + size_t(y + 1) * W * istride, 0.f);
+    });
 
     // Pass 1 along image x: sum over the components p of axis 1 (eq. 21).
     parallelRows(H, [&](int y) {
