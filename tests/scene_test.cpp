@@ -52,6 +52,29 @@ TEST(Scene, OccluderSpanFindsNearestAndFarthest) {
     EXPECT_FALSE(s.occluders({0, 0, 0.01f}, {0, 0, 1}, 0, 0.5f, 0).occluded);
 }
 
+TEST(Scene, OccluderSpanOfManyAndOfOneOccluder) {
+    // The span is found by two closest-hit queries (from each end): the middle occluder must not
+    // matter, and a single occluder gives tNear == tFar. Offsetting the segment's start shifts both.
+    SceneDesc d = oneQuad();
+    TriangleMesh m;
+    for (float z : {1.f, 1.7f, 2.5f}) appendQuad(m, {-1, -1, z}, {2, 0, 0}, {0, 2, 0}, 0);
+    appendQuad(m, {5, -1, 1.2f}, {2, 0, 0}, {0, 2, 0}, 0);  // only under x in [5, 7]
+    d.meshes.push_back(m);
+    Scene s(std::move(d));
+    OccluderSpan three = s.occluders({0, 0, 0}, {0, 0, 1}, 0.5f, 3.f, 0);
+    ASSERT_TRUE(three.occluded);
+    EXPECT_NEAR(three.tNear, 1.f, 1e-4f);
+    EXPECT_NEAR(three.tFar, 2.5f, 1e-4f);
+    OccluderSpan one = s.occluders({6, 0, 0}, {0, 0, 1}, 0.f, 3.f, 0);
+    ASSERT_TRUE(one.occluded);
+    EXPECT_NEAR(one.tNear, 1.2f, 1e-4f);
+    EXPECT_NEAR(one.tFar, 1.2f, 1e-4f);
+    // A segment ending between the occluders sees only those before its end.
+    OccluderSpan two = s.occluders({0, 0, 0}, {0, 0, 1}, 0.f, 2.f, 0);
+    ASSERT_TRUE(two.occluded);
+    EXPECT_NEAR(two.tFar, 1.7f, 1e-4f);
+}
+
 TEST(Scene, SphereNormalPointsOutward) {
     SceneDesc d = oneQuad();
     d.spheres.push_back({{0, 0, 10}, 1.f, 0, Vec3f(0.f)});

@@ -15,37 +15,6 @@ void embreeError(void*, RTCError code, const char* str) {
     std::fprintf(stderr, "wedge: Embree error %d: %s\n", int(code), str ? str : "");
 }
 
-/// Intersection context that records every hit and rejects it, so traversal visits all of them.
-/// Per packet lane, found through the ray id (robust to Embree calling the filter with any N).
-struct SpanContext {
-    RTCIntersectContext context;
-    float tNear[RayPacket::kSize], tFar[RayPacket::kSize];
-    bool any[RayPacket::kSize];
-};
-
-void spanFilter(const RTCFilterFunctionNArguments* args) {
-    auto* ctx = reinterpret_cast<SpanContext*>(args->context);
-    for (unsigned i = 0; i < args->N; ++i) {
-        if (args->valid[i] != -1) continue;
-        unsigned lane = RTCRayN_id(args->ray, args->N, i);
-        float t = RTCRayN_tfar(args->ray, args->N, i);  // the candidate hit distance
-        ctx->tNear[lane] = std::min(ctx->tNear[lane], t);
-        ctx->tFar[lane] = std::max(ctx->tFar[lane], t);
-        ctx->any[lane] = true;
-        args->valid[i] = 0;  // reject: keep traversing
-    }
-}
-
-void initSpan(SpanContext& sc) {
-    rtcInitIntersectContext(&sc.context);
-    sc.context.filter = spanFilter;
-    for (int i = 0; i < RayPacket::kSize; ++i) {
-        sc.tNear[i] = kInf;
-        sc.tFar[i] = 0;
-        sc.any[i] = false;
-    }
-}
-
 void toRtc(const RayPacket& r, RTCRay16& ray) {
     for (int i = 0; i < RayPacket::kSize; ++i) {
         ray.org_x[i] = r.org[i].x;
@@ -266,11 +235,16 @@ bool Scene::occluded(const Vec3f& org, const Vec3f& dir, float tNear, float tFar
 }
 
 OccluderSpan Scene::occluders(const Vec3f& org, const Vec3f& dir, float tNear, float tFar, float time) const {
-    SpanContext sc;
-    initSpan(sc);
-    RTCRayHit rh = makeRayHit(org, dir, tNear, tFar, time);
-    rtcIntersect1(m_scene, &sc.context, &rh);  // ray id 0: lane 0
-    return {sc.any[0], sc.tNear[0], sc.tFar[0]};
+    // One lane of the packet query, so that both paths are the same code.
+    RayPacket packet;
+    packet.set(0, org + dir * tNear, dir, tFar - tNear, time);
+    OccluderSpan spans[RayPacket::kSize];
+    occluders(packet, spans);
+    if (spans[0].occluded) {
+        spans[0].tNear += tNear;
+        spans[0].tFar += tNear;
+    }
+    return spans[0];
 }
 
 }  // namespace wedge::scene
