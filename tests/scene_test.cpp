@@ -10,7 +10,7 @@ namespace {
 
 SceneDesc oneQuad() {
     SceneDesc d;
-    d.materials.push_back({"white", Vec3f(0.5f), Vec3f(0.f)});
+    d.materials.push_back({"white", Vec3f(0.5f), Vec3f(0.f), "", 1.f});
     TriangleMesh m;
     appendQuad(m, {-1, -1, 0}, {2, 0, 0}, {0, 2, 0}, 0);  // normal +z
     d.meshes.push_back(m);
@@ -87,7 +87,7 @@ TEST(Scene, SphereNormalPointsOutward) {
 
 TEST(Scene, MotionBlurMovesGeometryOverTheShutter) {
     SceneDesc d;
-    d.materials.push_back({"white", Vec3f(0.5f), Vec3f(0.f)});
+    d.materials.push_back({"white", Vec3f(0.5f), Vec3f(0.f), "", 1.f});
     d.lights.push_back({{-0.5f, -0.5f, 5}, {1, 0, 0}, {0, -1, 0}, Vec3f(1.f)});
     TriangleMesh m;
     appendQuad(m, {-0.5f, -0.5f, 0}, {1, 0, 0}, {0, 1, 0}, 0);

@@ -38,7 +38,9 @@ std::string slurp(const fs::path& p) {
 
 std::string tempDir() {
     static int counter = 0;
-    fs::path p = root().path / ("d" + std::to_string(counter++));
+    std::string name = "d";  // not "d" + to_string(): GCC 12 warns falsely (-Wrestrict, bug 105329)
+    name += std::to_string(counter++);
+    fs::path p = root().path / name;
     fs::create_directories(p);
     return p.string();
 }
