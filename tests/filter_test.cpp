@@ -9,6 +9,7 @@
 #include "core/parallel.h"
 #include "core/sampler.h"
 #include "filter/aaf.h"
+#include "filter/defocus.h"
 #include "filter/maaf.h"
 #include "filter/maaf_components.h"
 
@@ -260,4 +261,85 @@ TEST(MaafFilter, ConstantSignalStaysConstantAndNoNan) {
         ASSERT_TRUE(isFinite(out[i]));
         EXPECT_NEAR(out[i].x, 0.75f, 1e-4f);
     }
+}
+
+namespace {
+
+/// A defocused plane: every pixel's lens samples have |s_u| >= b.
+FrameBuffers defocusedPlane(int w, int h, float b) {
+    Plane pl(w, h);
+    for (size_t i = 0; i < pl.fb.defocus.size(); ++i) pl.fb.defocus[i] = b;
+    return pl.fb;
+}
+
+}  // namespace
+
+TEST(DefocusFilter, ConstantStaysConstantAndInFocusIsIdentity) {
+    FrameBuffers fb = defocusedPlane(48, 40, 20.f);
+    Image3f c(48, 40, Vec3f(0.3f, 0.5f, 0.7f));
+    Image3f out = defocusFilter(c, fb);
+    for (size_t i = 0; i < out.size(); ++i) EXPECT_NEAR(out[i].y, 0.5f, 1e-5f);
+    // In focus (b = 0, and b below Omega_u: support under one pixel): untouched.
+    for (float b : {0.f, 1.5f}) {
+        FrameBuffers sharp = defocusedPlane(48, 40, b);
+        Image3f noisy(48, 40);
+        for (size_t i = 0; i < noisy.size(); ++i) noisy[i] = Vec3f(rnd(uint32_t(i)));
+        Image3f same = defocusFilter(noisy, sharp);
+        for (size_t i = 0; i < same.size(); ++i) EXPECT_EQ(same[i].x, noisy[i].x);
+    }
+}
+
+TEST(DefocusFilter, RemovesNoiseOfABlurredSignalAndKeepsItsShape) {
+    // An edge blurred by a circle of confusion of radius b = 16 px, plus white noise: the filter
+    // (support b / 2) removes most of the noise and keeps the blurred edge within 3% of its
+    // contrast (0.6).
+    const int W = 96, H = 64;
+    const float b = 16.f;
+    FrameBuffers fb = defocusedPlane(W, H, b);
+    Image3f clean(W, H), noisy(W, H);
+    for (int y = 0; y < H; ++y)
+        for (int x = 0; x < W; ++x) {
+            // A step seen through a disc of radius b: the disc's area left of the step.
+            float d = std::clamp((float(x) + 0.5f - 48.f) / b, -1.f, 1.f);
+            float t = (kPi - std::acos(d) + d * std::sqrt(1.f - d * d)) / kPi;
+            float v = 0.2f + 0.6f * t;
+            clean(x, y) = Vec3f(v);
+            noisy(x, y) = Vec3f(v + 0.2f * (rnd(uint32_t(y * W + x)) - 0.5f));
+        }
+    Image3f out = defocusFilter(noisy, fb);
+    double errIn = 0, errOut = 0;
+    float worstBias = 0;
+    for (int y = 12; y < H - 12; ++y)
+        for (int x = 12; x < W - 12; ++x) {
+            errIn += sqr(noisy(x, y).x - clean(x, y).x);
+            errOut += sqr(out(x, y).x - clean(x, y).x);
+        }
+    EXPECT_LT(errOut, 0.1 * errIn);
+    // Bias on the noise-free ramp: the filter stays inside the band the defocus leaves.
+    Image3f smooth = defocusFilter(clean, fb);
+    for (int x = 0; x < W; ++x) worstBias = std::max(worstBias, std::abs(smooth(x, H / 2).x - clean(x, H / 2).x));
+    EXPECT_LT(worstBias, 0.018f) << worstBias;
+}
+
+TEST(DefocusFilter, SharperNeighboursAndEmissionAreNotMixedIn) {
+    // Left half in focus (b = 0) with a fine checker, right half defocused: the left half stays
+    // exact, and the right half takes nothing from it. Emission passes through unfiltered.
+    const int W = 64, H = 32;
+    FrameBuffers fb = defocusedPlane(W, H, 0.f);
+    Image3f c(W, H);
+    for (int y = 0; y < H; ++y)
+        for (int x = 0; x < W; ++x) {
+            size_t i = size_t(y) * W + x;
+            if (x >= W / 2) fb.defocus[i] = 16.f;
+            c[i] = x < W / 2 ? Vec3f(float((x + y) & 1)) : Vec3f(0.25f);
+        }
+    fb.emission(40, 16) = Vec3f(50.f);
+    c(40, 16) += Vec3f(50.f);
+    Image3f out = defocusFilter(c, fb);
+    for (int y = 0; y < H; ++y)
+        for (int x = 0; x < W; ++x) {
+            if (x == 40 && y == 16) EXPECT_NEAR(out(x, y).x, 50.25f, 1e-4f);
+            else if (x < W / 2) EXPECT_EQ(out(x, y).x, c(x, y).x);
+            else EXPECT_NEAR(out(x, y).x, 0.25f, 1e-5f) << x << "," << y;
+        }
 }

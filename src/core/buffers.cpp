@@ -9,7 +9,7 @@ FrameBuffers::FrameBuffers(int w, int h)
       position(w, h), rest(w, h), depth(w, h), spp(w, h), object(w, h), coverage(w, h), variance(w, h),
       directUnoccluded(w, h), visibility(w, h), unoccluded(w, h), albedo2(w, h), normal2(w, h), position2(w, h),
       direct2(w, h), indirect2(w, h), directUnoccluded2(w, h), object2(w, h), coverage2(w, h), d1(w, h), sMax(w, h), sMin(w, h),
-      occluded(w, h), zMin(w, h), zMax(w, h), suMin(w, h), suMax(w, h), footprint(w, h) {}
+      occluded(w, h), zMin(w, h), zMax(w, h), suMin(w, h), suMax(w, h), defocus(w, h), footprint(w, h) {}
 
 void FrameBuffers::forEachPlane(const std::function<void(const std::string&, int, const float*)>& fn) const {
     auto v3 = [&](const char* n, const Image3f& img) { fn(n, 3, &img[0].x); };
@@ -41,6 +41,7 @@ void FrameBuffers::forEachPlane(const std::function<void(const std::string&, int
     v1("slope.zmax", zMax);
     v1("slope.sumin", suMin);
     v1("slope.sumax", suMax);
+    v1("slope.defocus", defocus);
     v1("footprint", footprint);
 }
 

@@ -74,6 +74,8 @@ struct FrameBuffers {
     Image1f occluded;      // fraction of shadow rays that hit an occluder
     Image1f zMin, zMax;    // bounce distances
     Image1f suMin, suMax;  // defocus slopes, pixels per unit lens coordinate
+    Image1f defocus;       // smallest |defocus slope| over all of the pixel's initial samples, every
+                           // surface and misses (0 where they straddle the focal plane)
     Image1f footprint;     // world size of one pixel at the hit
 
     FrameBuffers() = default;

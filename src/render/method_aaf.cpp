@@ -6,6 +6,7 @@
 
 #include "core/parallel.h"
 #include "filter/aaf.h"
+#include "filter/defocus.h"
 #include "io/image_io.h"
 #include "render/aov.h"
 #include "render/methods.h"
@@ -74,6 +75,8 @@ void renderAaf(const MethodContext& ctx, RenderResult& result) {
     for (size_t i = 0; i < direct.size(); ++i) direct[i] = fb.directUnoccluded[i] * filteredVisibility[i].x;
     Image3f indirect = filter::aafFilter(fb.indirect, params.omegaIndirect, fb, frames.indirect, ao);
     result.color = fb.composeFiltered(direct, indirect);
+    // The primary (defocus) filter of the composited radiance (filter/defocus.h).
+    if (view.apertureRadius > 0) result.color = filter::defocusFilter(result.color, fb);
     result.seconds.add("filter", t.seconds());
 
     if (!ctx.options.aovDir.empty()) {

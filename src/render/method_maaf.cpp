@@ -13,6 +13,7 @@
 #include "core/error.h"
 #include "core/parallel.h"
 #include "filter/aaf.h"
+#include "filter/defocus.h"
 #include "filter/maaf.h"
 #include "io/image_io.h"
 #include "render/aov.h"
@@ -171,6 +172,8 @@ void renderMaaf(const MethodContext& ctx, RenderResult& result) {
     for (size_t i = 0; i < pixels; ++i) direct[i] = fb.directUnoccluded[i] * direct[i].x;
     Image3f indirect = accIndirect.filter(params.indirect, fb, frames.indirect, fb.indirect, mo);
     result.color = fb.composeFiltered(direct, indirect);
+    // The primary (defocus) filter of the composited radiance (filter/defocus.h).
+    if (view.apertureRadius > 0) result.color = filter::defocusFilter(result.color, fb);
     result.seconds.add("filter", t.seconds());
 
     if (!ctx.options.aovDir.empty()) {

@@ -55,6 +55,11 @@ int PixelStats::add(const TracedSample& s, const ViewGeometry& view, bool slopes
     float lum = luminance(l);
     lumSum += lum;
     lumSq += lum * lum;
+    if (slopes) {
+        float su = view.defocusSlope(s.hit ? s.depth : kInf);
+        suLo = std::min(suLo, su);
+        suHi = std::max(suHi, su);
+    }
     if (!s.hit) return -1;
     for (int k = 0; k < 2; ++k)
         if (slot[k].n == 0 || slot[k].matches(s)) {
@@ -73,6 +78,7 @@ void PixelStats::store(FrameBuffers& fb, int x, int y, const ViewGeometry& view)
     fb.emission[p] = emission * invN;
     fb.spp[p] = float(n);
     float mean = lumSum * invN;
+    fb.defocus[p] = suLo > suHi || (suLo < 0 && suHi > 0) ? 0.f : std::min(std::abs(suLo), std::abs(suHi));
     fb.variance[p] = n > 1 ? std::max(0.f, lumSq * invN - mean * mean) / float(n - 1) : 0.f;
     Vec3f slotLight = m.rhoDirect + m.rhoIndirect + m2.rhoDirect + m2.rhoIndirect;
     fb.rest[p] = (light - slotLight) * invN;
