@@ -1,7 +1,8 @@
 // --method aaf: axis-aligned filtering with adaptive sampling for soft shadows, indirect light
 // and depth of field together (filter/aaf.h has the formulas). Stages: initial sampling (with
 // occluder spans for the slopes), prefilter (slope fill, bandwidths, rates), adaptive sampling,
-// filter (direct and indirect separately, demodulated, then multiplied by albedo).
+// filter (direct and indirect separately, demodulated, then multiplied by albedo; last, the
+// defocus filter of the composited radiance, filter/defocus.h).
 #include <cmath>
 
 #include "core/parallel.h"

@@ -4,7 +4,8 @@
 // prefilter: slopes over a 5x5 window, components per pixel, then the accumulation of eq. 23
 // over each pixel's samples; adaptive sampling only where the wedge degenerates at the focal
 // plane (central filter, AAF rates, at most 100 more samples); filter: eq. 21 on both image
-// axes for direct and indirect light, then multiplied by albedo.
+// axes for direct and indirect light, then multiplied by albedo; last, the defocus filter of the
+// composited radiance (filter/defocus.h).
 #include <cmath>
 #include <fstream>
 #include <string>
