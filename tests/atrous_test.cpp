@@ -8,6 +8,7 @@
 #include "core/error.h"
 #include "filter/atrous.h"
 #include "metrics/metrics.h"
+#include "render/methods.h"
 #include "render/renderer.h"
 #include "scene/scene.h"
 #include "scene/scene_loader.h"
@@ -207,7 +208,7 @@ TEST(AtrousMethod, BeatsMonteCarloAtTheSameSamplesOnCornell) {
     render::RenderResult at = render::render(scene, o);
     EXPECT_GT(at.seconds.get("filter"), 0.0);
     EXPECT_GE(at.sppAverage, 4.0);  // plus the emitter-edge top-up
-    EXPECT_LT(at.sppAverage, 5.0);
+    EXPECT_LT(at.sppAverage, 4.0 + 0.02 * render::kEmitterEdgeSpp);  // at most 2% of the pixels topped up
     double eMc = metrics::relMse(mc.color, reference), eAt = metrics::relMse(at.color, reference);
     EXPECT_LT(eAt, 0.8 * eMc) << "mc " << eMc << " atrous " << eAt;
     EXPECT_GT(metrics::ssim(at.color, reference), metrics::ssim(mc.color, reference));
