@@ -18,6 +18,12 @@ SceneDesc oneQuad() {
     return d;
 }
 
+void expectSpan(const OccluderSpan& span, float tNear, float tFar) {
+    ASSERT_TRUE(span.occluded);
+    EXPECT_NEAR(span.tNear, tNear, 1e-4f);
+    EXPECT_NEAR(span.tFar, tFar, 1e-4f);
+}
+
 }  // namespace
 
 TEST(Scene, TriangleNormalIsCounterClockwise) {
@@ -43,10 +49,7 @@ TEST(Scene, OccluderSpanFindsNearestAndFarthest) {
     appendQuad(m, {-1, -1, 2.5f}, {2, 0, 0}, {0, 2, 0}, 0);
     d.meshes.push_back(m);
     Scene s(std::move(d));
-    OccluderSpan span = s.occluders({0, 0, 0.01f}, {0, 0, 1}, 0, 10, 0);
-    ASSERT_TRUE(span.occluded);
-    EXPECT_NEAR(span.tNear, 0.99f, 1e-4f);
-    EXPECT_NEAR(span.tFar, 2.49f, 1e-4f);
+    expectSpan(s.occluders({0, 0, 0.01f}, {0, 0, 1}, 0, 10, 0), 0.99f, 2.49f);
     EXPECT_TRUE(s.occluded({0, 0, 0.01f}, {0, 0, 1}, 0, 10, 0));
     EXPECT_FALSE(s.occluded({0, 0, 0.01f}, {0, 0, 1}, 0, 0.5f, 0));
     EXPECT_FALSE(s.occluders({0, 0, 0.01f}, {0, 0, 1}, 0, 0.5f, 0).occluded);
@@ -61,18 +64,10 @@ TEST(Scene, OccluderSpanOfManyAndOfOneOccluder) {
     appendQuad(m, {5, -1, 1.2f}, {2, 0, 0}, {0, 2, 0}, 0);  // only under x in [5, 7]
     d.meshes.push_back(m);
     Scene s(std::move(d));
-    OccluderSpan three = s.occluders({0, 0, 0}, {0, 0, 1}, 0.5f, 3.f, 0);
-    ASSERT_TRUE(three.occluded);
-    EXPECT_NEAR(three.tNear, 1.f, 1e-4f);
-    EXPECT_NEAR(three.tFar, 2.5f, 1e-4f);
-    OccluderSpan one = s.occluders({6, 0, 0}, {0, 0, 1}, 0.f, 3.f, 0);
-    ASSERT_TRUE(one.occluded);
-    EXPECT_NEAR(one.tNear, 1.2f, 1e-4f);
-    EXPECT_NEAR(one.tFar, 1.2f, 1e-4f);
+    expectSpan(s.occluders({0, 0, 0}, {0, 0, 1}, 0.5f, 3.f, 0), 1.f, 2.5f);
+    expectSpan(s.occluders({6, 0, 0}, {0, 0, 1}, 0.f, 3.f, 0), 1.2f, 1.2f);
     // A segment ending between the occluders sees only those before its end.
-    OccluderSpan two = s.occluders({0, 0, 0}, {0, 0, 1}, 0.f, 2.f, 0);
-    ASSERT_TRUE(two.occluded);
-    EXPECT_NEAR(two.tFar, 1.7f, 1e-4f);
+    expectSpan(s.occluders({0, 0, 0}, {0, 0, 1}, 0.f, 2.f, 0), 1.f, 1.7f);
 }
 
 TEST(Scene, SphereNormalPointsOutward) {
