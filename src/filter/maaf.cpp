@@ -302,6 +302,26 @@ bool neighbour(const FrameBuffers& fb, const Image<MaafPixel>& params, const Axi
     return true;
 }
 
+/// The neighbours of pixel (x, y) along image axis `axis` within the pixel's window:
+/// ok[k + radius] where neighbour() accepts the pixel at offset k, with its a and r.
+struct Window {
+    static constexpr int kMaxRadius = 128;
+    int radius;
+    bool ok[2 * kMaxRadius + 1];
+    float a[2 * kMaxRadius + 1], r[2 * kMaxRadius + 1];
+
+    Window(const FrameBuffers& fb, const Image<MaafPixel>& params, const AxisFrame& f, int x, int y, int axis,
+           const MaafOptions& o) {
+        const size_t p = size_t(y) * fb.width + x;
+        radius = std::min(windowRadius(params[p].axis[axis], f.step[axis], o.maxRadius), kMaxRadius);
+        for (int k = -radius; k <= radius; ++k) {
+            int xx = axis == 0 ? x + k : x, yy = axis == 0 ? y : y + k;
+            ok[k + radius] = xx >= 0 && xx < fb.width && yy >= 0 && yy < fb.height &&
+                             neighbour(fb, params, f, p, size_t(yy) * fb.width + xx, axis, o, a[k + radius], r[k + radius]);
+        }
+    }
+};
+
 }  // namespace
 
 Image3f MaafAccumulator::filter(const Image<MaafPixel>& params, const FrameBuffers& fb, const Image<AxisFrame>& frames,
@@ -321,22 +341,15 @@ Image3f MaafAccumulator::filter(const Image<MaafPixel>& params, const FrameBuffe
             const MaafAxis& ax = params[p].axis[0];
             const AxisFrame& f = frames[p];
             float* out = &inter[p * istride];
-            int radius = windowRadius(ax, f.step[0], o.maxRadius);
-            bool ok[2 * 128 + 1];
-            float av[2 * 128 + 1], rv[2 * 128 + 1];
-            radius = std::min(radius, 128);
+            const Window win(fb, params, f, x, y, 0, o);
+            const int radius = win.radius;
             for (int k = -radius; k <= radius; ++k) {
-                int xx = x + k;
-                ok[k + radius] = xx >= 0 && xx < W &&
-                                 neighbour(fb, params, f, p, size_t(y) * W + xx, 0, o, av[k + radius], rv[k + radius]);
-            }
-            for (int k = -radius; k <= radius; ++k) {
-                if (!ok[k + radius]) continue;
+                if (!win.ok[k + radius]) continue;
                 // Outer components only where the mirror neighbour exists too: a one-sided window
                 // (an occluder's silhouette next to its shadow) would turn their modulation into bias.
-                bool mirror = !o.symmetricOuter || ok[radius - k];
+                bool mirror = !o.symmetricOuter || win.ok[radius - k];
                 size_t q = size_t(y) * W + x + k;
-                float a = av[k + radius], r = rv[k + radius];
+                float a = win.a[k + radius], r = win.r[k + radius];
                 const float* T = pixel(q);
                 const int nq = (m_bands1[q] + 1) / 2, bq2 = m_bands2[q];  // the neighbour's own bands
                 for (int c = 0; c < (mirror ? ax.pairs : 1); ++c) {
@@ -370,20 +383,14 @@ Image3f MaafAccumulator::filter(const Image<MaafPixel>& params, const FrameBuffe
             }
             const MaafAxis& ax = params[p].axis[1];
             const AxisFrame& f = frames[p];
-            int radius = std::min(windowRadius(ax, f.step[1], o.maxRadius), 128);
             float h[4] = {0, 0, 0, 0}, h0[4] = {0, 0, 0, 0};  // values..., weight (C <= 4)
-            bool ok[2 * 128 + 1];
-            float av[2 * 128 + 1], rv[2 * 128 + 1];
+            const Window win(fb, params, f, x, y, 1, o);
+            const int radius = win.radius;
             for (int k = -radius; k <= radius; ++k) {
-                int yy = y + k;
-                ok[k + radius] = yy >= 0 && yy < H &&
-                                 neighbour(fb, params, f, p, size_t(yy) * W + x, 1, o, av[k + radius], rv[k + radius]);
-            }
-            for (int k = -radius; k <= radius; ++k) {
-                if (!ok[k + radius]) continue;
-                bool mirror = !o.symmetricOuter || ok[radius - k];
+                if (!win.ok[k + radius]) continue;
+                bool mirror = !o.symmetricOuter || win.ok[radius - k];
                 size_t q = size_t(y + k) * W + x;
-                float a = av[k + radius], r = rv[k + radius];
+                float a = win.a[k + radius], r = win.r[k + radius];
                 const float* I = &inter[q * istride];
                 for (int c = 0; c < (mirror ? ax.pairs : 1); ++c) {
                     float sr = ax.sx[c] * r;

@@ -7,7 +7,6 @@
 
 #include "core/parallel.h"
 #include "filter/aaf.h"
-#include "filter/defocus.h"
 #include "io/image_io.h"
 #include "render/aov.h"
 #include "render/methods.h"
@@ -69,15 +68,10 @@ void renderAaf(const MethodContext& ctx, RenderResult& result) {
     filter::FilterFrames frames = filter::computeFrames(fb, view);
     // Direct light as in report eq. 3.2: filter the visibility (weighted by the unoccluded light
     // the samples saw), multiply by the closed-form unoccluded irradiance.
-    Image3f visibility(W, H);
-    for (size_t i = 0; i < visibility.size(); ++i) visibility[i] = Vec3f(fb.visibility[i]);
-    Image3f filteredVisibility = filter::aafFilter(visibility, params.omegaDirect, fb, frames.direct, ao, &fb.unoccluded);
-    Image3f direct(W, H);
-    for (size_t i = 0; i < direct.size(); ++i) direct[i] = fb.directUnoccluded[i] * filteredVisibility[i].x;
+    Image3f visibility =
+        filter::aafFilter(visibilityImage(fb), params.omegaDirect, fb, frames.direct, ao, &fb.unoccluded);
     Image3f indirect = filter::aafFilter(fb.indirect, params.omegaIndirect, fb, frames.indirect, ao);
-    result.color = fb.composeFiltered(direct, indirect);
-    // The primary (defocus) filter of the composited radiance (filter/defocus.h).
-    if (view.apertureRadius > 0) result.color = filter::defocusFilter(result.color, fb);
+    result.color = composeFilteredLight(fb, view, visibility, indirect);
     result.seconds.add("filter", t.seconds());
 
     if (!ctx.options.aovDir.empty()) {

@@ -14,7 +14,6 @@
 #include "core/error.h"
 #include "core/parallel.h"
 #include "filter/aaf.h"
-#include "filter/defocus.h"
 #include "filter/maaf.h"
 #include "io/image_io.h"
 #include "render/aov.h"
@@ -167,14 +166,9 @@ void renderMaaf(const MethodContext& ctx, RenderResult& result) {
         }
     });
     // Direct light as in AAF (report eq. 3.2): filtered visibility x closed-form unoccluded light.
-    Image3f visibility(W, H);
-    for (size_t i = 0; i < pixels; ++i) visibility[i] = Vec3f(fb.visibility[i]);
-    Image3f direct = accDirect.filter(params.direct, fb, frames.direct, visibility, mo);
-    for (size_t i = 0; i < pixels; ++i) direct[i] = fb.directUnoccluded[i] * direct[i].x;
+    Image3f visibility = accDirect.filter(params.direct, fb, frames.direct, visibilityImage(fb), mo);
     Image3f indirect = accIndirect.filter(params.indirect, fb, frames.indirect, fb.indirect, mo);
-    result.color = fb.composeFiltered(direct, indirect);
-    // The primary (defocus) filter of the composited radiance (filter/defocus.h).
-    if (view.apertureRadius > 0) result.color = filter::defocusFilter(result.color, fb);
+    result.color = composeFilteredLight(fb, view, visibility, indirect);
     result.seconds.add("filter", t.seconds());
 
     if (!ctx.options.aovDir.empty()) {

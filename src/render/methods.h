@@ -39,4 +39,13 @@ void storeStats(const Image<PixelStats>& stats, const MethodContext& ctx, FrameB
 /// Average samples per pixel of `fb.spp`.
 double averageSpp(const FrameBuffers& fb);
 
+/// The primary surface's visibility as rgb, the input of the direct-light filters.
+Image3f visibilityImage(const FrameBuffers& fb);
+/// The last step of aaf and maaf: direct light as the closed-form unoccluded irradiance times
+/// the filtered visibility (AAF report eq. 3.2), composed with the filtered indirect light
+/// (FrameBuffers::composeFiltered), then, where the camera has a lens, the defocus filter of the
+/// composited radiance (filter/defocus.h).
+Image3f composeFilteredLight(const FrameBuffers& fb, const ViewGeometry& view, const Image3f& filteredVisibility,
+                             const Image3f& filteredIndirect);
+
 }  // namespace wedge::render

@@ -2,6 +2,7 @@
 
 #include "core/error.h"
 #include "core/parallel.h"
+#include "filter/defocus.h"
 #include "render/methods.h"
 #include "render/sampling.h"
 #include "scene/light_irradiance.h"
@@ -24,6 +25,20 @@ void storeStats(const Image<PixelStats>& stats, const MethodContext& ctx, FrameB
                                      : scene::unoccludedIrradiance(lights, fb.position2[p], fb.normal2[p]) * kInvPi;
         }
     });
+}
+
+Image3f visibilityImage(const FrameBuffers& fb) {
+    Image3f v(fb.width, fb.height);
+    for (size_t i = 0; i < v.size(); ++i) v[i] = Vec3f(fb.visibility[i]);
+    return v;
+}
+
+Image3f composeFilteredLight(const FrameBuffers& fb, const ViewGeometry& view, const Image3f& filteredVisibility,
+                             const Image3f& filteredIndirect) {
+    Image3f direct(fb.width, fb.height);
+    for (size_t i = 0; i < direct.size(); ++i) direct[i] = fb.directUnoccluded[i] * filteredVisibility[i].x;
+    Image3f color = fb.composeFiltered(direct, filteredIndirect);
+    return view.apertureRadius > 0 ? filter::defocusFilter(color, fb) : color;
 }
 
 double averageSpp(const FrameBuffers& fb) {
