@@ -101,6 +101,8 @@ void registerExperiment(CLI::App& app) {
         ->check(CLI::IsMember({3, 5, 7}));
     cmd->add_flag("!--no-focal-fallback", r.maafFocalFallback,
                   "maaf: keep all components where the defocus slope changes sign");
+    cmd->add_option("--maaf-weights", r.maafWeights, "maaf: component weights mu_p (sampling, eq10 or unit)")
+        ->check(CLI::IsMember({"sampling", "eq10", "unit"}));
     cmd->add_option("--atrous-iterations", r.atrousIterations, "atrous: wavelet levels")->check(CLI::Range(1, 10));
     cmd->add_option("--sigma-color", r.atrousSigmaColor, "atrous: colour edge-stopping sigma")->check(CLI::PositiveNumber);
     cmd->add_option("--sigma-normal", r.atrousSigmaNormal, "atrous: normal edge-stopping sigma")->check(CLI::PositiveNumber);

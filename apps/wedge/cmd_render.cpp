@@ -74,6 +74,9 @@ void registerRender(CLI::App& app) {
                   "maaf: keep all components where the defocus slope changes sign (shows the ringing)");
     cmd->add_flag("--maaf-windows", args->options.maafWindows,
                   "maaf: weigh light and lens samples by eq. 20's Gaussian windows (biased for uniform lights)");
+    cmd->add_option("--maaf-weights", args->options.maafWeights,
+                    "maaf: component weights mu_p: the sampling densities' spectra (default), eq. 10's Gaussian, or 1")
+        ->check(CLI::IsMember({"sampling", "eq10", "unit"}));
     cmd->add_option("--atrous-iterations", args->options.atrousIterations, "atrous: wavelet levels")
         ->check(CLI::Range(1, 10));
     cmd->add_option("--sigma-color", args->options.atrousSigmaColor, "atrous: colour edge-stopping sigma")

@@ -35,6 +35,7 @@ struct ViewGeometry {
     float focusDistance = 1;   // world, along forward
     struct Light {
         Vec3f center, normal, axisA, axisB;  // axisA/B: orthonormal in the light plane
+        Vec3f edge1{0.f}, edge2{0.f};          // the parallelogram's edges (a point is center + a edge1 + b edge2, |a|, |b| <= 1/2)
         float sigma = 1;                     // Gaussian model of the light: sqrt(area)/2
         float power = 1;                     // luminance of radiance x area
     };

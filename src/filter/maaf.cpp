@@ -19,7 +19,22 @@ struct AxisInputs {
     double omegaU = 6;
     double step = 1;                        // world size of a pixel along the axis
     bool fallback = false;
+    // The density y is sampled from: a parallelogram light whose edges project to lengths
+    // (edge1, edge2) on the axis, or the unit disc of a cosine-weighted bounce.
+    bool light = false;
+    double edge1 = 0, edge2 = 0;
 };
+
+/// mu_p: the weight of component c (maaf.h, "Weights").
+double componentWeight(const MaafComponent& c, const AxisInputs& in, MaafWeights weights) {
+    switch (weights) {
+    case MaafWeights::Eq10: return c.mu;
+    case MaafWeights::Unit: return 1.0;
+    case MaafWeights::Sampling: break;
+    }
+    double mu = in.light ? parallelogramSpectrum(c.cy, in.edge1, in.edge2) : discSpectrum(c.cy);
+    return in.lens ? mu * discSpectrum(c.cu) : mu;
+}
 
 MaafAxis buildAxis(const AxisInputs& in, const MaafOptions& o) {
     const int pairs = o.pairs, maxRadius = o.maxRadius;
@@ -70,7 +85,7 @@ MaafAxis buildAxis(const AxisInputs& in, const MaafOptions& o) {
         const MaafComponent& c = comps[p];
         ax.cx[p] = float(c.cx);
         ax.sx[p] = std::max(float(c.sx) * o.spatialScale, sxFloor);
-        ax.weight[p] = float((p == 0 ? 1.0 : 2.0) * (o.weightsEq10 ? c.mu : 1.0));
+        ax.weight[p] = float((p == 0 ? 1.0 : 2.0) * componentWeight(c, in, o.weights));
         ax.cy[p] = float(c.cy);
         ax.cu[p] = in.lens ? float(uSign * c.cu) : 0.f;
         ax.sy[p] = o.apertureWindows ? float(c.sy) : 0.f;  // 0: no window
@@ -86,7 +101,12 @@ MaafParams maafParams(const FrameBuffers& fb, const WedgeField& wf, const Filter
     const int W = fb.width, H = fb.height;
     MaafParams mp{Image<MaafPixel>(W, H, NoInit{}), Image<MaafPixel>(W, H, NoInit{}), Image1f(W, H)};
     float sigma = kInf;
-    for (auto& l : view.lights) sigma = std::min(sigma, l.sigma);
+    const ViewGeometry::Light* smallest = nullptr;  // the most demanding light sets the direct wedge
+    for (auto& l : view.lights)
+        if (l.sigma < sigma) {
+            sigma = l.sigma;
+            smallest = &l;
+        }
     const bool lens = view.apertureRadius > 0;
     parallelRows(H, [&](int y) {
         for (int x = 0; x < W; ++x) {
@@ -114,7 +134,12 @@ MaafParams maafParams(const FrameBuffers& fb, const WedgeField& wf, const Filter
                 in.sMax = std::max(wf.s1[p], wf.s2[p]);
                 in.suMin = wf.suMin[p] * in.step;
                 in.suMax = wf.suMax[p] * in.step;
+                const Vec3f& axis = frames.direct[p].axis[k];
+                in.edge1 = smallest ? std::abs(dot(smallest->edge1, axis)) : 0.0;
+                in.edge2 = smallest ? std::abs(dot(smallest->edge2, axis)) : 0.0;
+                in.light = true;
                 mp.direct[p].axis[k] = buildAxis(in, o);
+                in.light = false;  // the bounce: a cosine-weighted direction
                 // Indirect: bounce wedge in the tangent plane (z clamped to two pixel sizes).
                 in.step = frames.indirect[p].step[k];
                 in.yWedge = wf.zMin[p] < kInf;

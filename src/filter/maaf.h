@@ -28,7 +28,18 @@
 // the kernel's argument is -y, so the phase is C_x a - C_y y, which is what is used.
 //
 // Spatial Gaussians are unit-integral, so that component p peaks at mu_p along Omega_x as eq. 9
-// says. Four practical conventions, each measured against a 4096-spp reference (README):
+// says. Five practical conventions, each measured against a reference (README):
+//  - Weights: eq. 10 weighs component p by a Gaussian over the double wedge, the spectrum of a
+//    Gaussian light of std sqrt(area) / 2. Without eq. 20's windows the light and lens samples
+//    are drawn from the light's and the aperture's own densities, so the kernel over a sample's
+//    (y, u) is sum_p mu_p cos(C_y y + C_u u): a Fourier series that reproduces the sheared light
+//    profile only if mu_p is that density's spectrum at (C_y, C_u). By default mu_p is that
+//    spectrum: parallelogramSpectrum (sinc x sinc of the light's edges projected on the axis)
+//    times discSpectrum (2 J1(w) / w) for the lens; discSpectrum for the cosine-weighted bounce.
+//    Checked numerically on a flatland penumbra (unbounded window, tests/filter_test.cpp,
+//    MaafWeights): N = 3's bias is 0.030 (eq. 10) vs 0.026 under a square light and 0.109 vs
+//    0.037 under a 4:1 strip seen along its length, whose sqrt(area) misstates the extent.
+//    Renders: sponza relMSE -17%, conference -3%, cornell -2%. `--maaf-weights eq10` restores eq. 10.
 //  - Fourier widths: the paper's Gaussians have the box half-widths of eq. 8 as standard
 //    deviation, which attenuates the wedge's edge by e^-1/2 and over-blurs; the spatial Fourier
 //    std is sqrt(6) times the half-width, the factor AAF's kernel exp(-3 r^2 Omega^2) implies.
@@ -74,6 +85,12 @@ struct MaafPixel {
     MaafAxis axis[2];
 };
 
+enum class MaafWeights {
+    Sampling,  // the spectra of the light's, the lens's and the bounce's sampling densities (default)
+    Eq10,      // eq. 10's Gaussian over the double wedge (a Gaussian light)
+    Unit,      // every component weighs 1
+};
+
 struct MaafOptions {
     int pairs = 3;               // N: 2N-1 components per axis (--maaf-components 5)
     float mu = 2.f;              // Omega_y^max = mu / sigma_light (as AAF)
@@ -89,7 +106,7 @@ struct MaafOptions {
     float spatialScale = 2.449490f;  // Fourier std of the spatial Gaussians = sqrt(6) x the half-width (AAF's kernel)
     float pixelBandwidth = 2.449490f;  // Omega_x never exceeds this / (world size of a pixel)
     bool apertureWindows = false;    // eq. 20's Gaussian windows over the light and the lens
-    bool weightsEq10 = true;         // mu_p per eq. 10 (false: all components weigh 1)
+    MaafWeights weights = MaafWeights::Sampling;  // mu_p
     bool fitComponents = true;       // use only as many components as the window resolves
     bool symmetricOuter = true;      // outer components only where a neighbour's mirror is accepted too
 };

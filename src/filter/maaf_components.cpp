@@ -42,6 +42,17 @@ void maafComponents(int pairs, const WedgeShape& w, MaafComponent* out) {
     }
 }
 
+namespace {
+double sinc(double x) { return std::abs(x) < 1e-8 ? 1.0 : std::sin(x) / x; }
+}  // namespace
+
+double parallelogramSpectrum(double w, double e1, double e2) { return sinc(0.5 * w * e1) * sinc(0.5 * w * e2); }
+
+double discSpectrum(double w) {
+    double a = std::abs(w);
+    return a < 1e-8 ? 1.0 : 2.0 * std::cyl_bessel_j(1.0, a) / a;
+}
+
 double fourierGaussian(double w, double sigma) { return std::exp(-0.5 * w * w / (sigma * sigma)); }
 
 double maafSpectrum(const std::vector<MaafComponent>& comps, double wx, double wy, bool box) {

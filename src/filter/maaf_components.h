@@ -45,6 +45,15 @@ std::vector<MaafComponent> maafComponents(int pairs, const WedgeShape& wedge);
 /// The same into out[0..pairs) without allocating (the renderer calls it for every pixel).
 void maafComponents(int pairs, const WedgeShape& wedge, MaafComponent* out);
 
+/// Characteristic functions E[cos(w y)] of the densities MAAF's samples are drawn from, the
+/// spectra the component weights follow by default (maaf.h):
+/// y = the projection onto a unit axis of a point uniform on a parallelogram whose edges project
+/// to lengths e1 and e2 (a light): sinc(w e1 / 2) sinc(w e2 / 2);
+double parallelogramSpectrum(double w, double e1, double e2);
+/// y = one coordinate of a point uniform on the unit disc (the lens; a cosine-weighted direction
+/// projected onto its tangent plane): 2 J1(|w|) / |w|.
+double discSpectrum(double w);
+
 /// Peak-one Fourier Gaussian G(w; sigma).
 double fourierGaussian(double w, double sigma);
 

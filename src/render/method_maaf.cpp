@@ -46,6 +46,10 @@ void renderMaaf(const MethodContext& ctx, RenderResult& result) {
     filter::MaafOptions mo;
     mo.pairs = (ctx.options.maafComponents + 1) / 2;
     mo.apertureWindows = ctx.options.maafWindows;
+    if (ctx.options.maafWeights == "eq10") mo.weights = filter::MaafWeights::Eq10;
+    else if (ctx.options.maafWeights == "unit") mo.weights = filter::MaafWeights::Unit;
+    else if (ctx.options.maafWeights != "sampling")
+        throw Error("--maaf-weights", "expected sampling, eq10 or unit, got '" + ctx.options.maafWeights + "'");
     mo.focalFallback = ctx.options.maafFocalFallback;
     if (mo.pairs < 1 || mo.pairs > filter::kMaafMaxPairs)
         throw Error("--maaf-components", "expected 1, 3, 5 or 7 components");

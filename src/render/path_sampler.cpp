@@ -24,6 +24,8 @@ ViewGeometry PathSampler::view() const {
         g.normal = l.normal();
         g.axisA = normalize(l.edge1);
         g.axisB = normalize(cross(g.normal, g.axisA));
+        g.edge1 = l.edge1;
+        g.edge2 = l.edge2;
         g.sigma = l.sigma();
         g.power = luminance(l.radiance) * l.area();
         v.lights.push_back(g);

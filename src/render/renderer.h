@@ -28,6 +28,7 @@ struct RenderOptions {
     int maafComponents = 5;          // 2N-1 filters per 2D/3D subspace
     bool maafFocalFallback = true;   // fall back to the central filter where the defocus slope changes sign
     bool maafWindows = false;        // eq. 20's Gaussian windows over light and lens samples
+    std::string maafWeights = "sampling";  // mu_p: sampling | eq10 | unit (filter/maaf.h, "Weights")
     // à-trous
     int atrousIterations = 5;
     float atrousSigmaColor = 4.f, atrousSigmaNormal = 0.5f, atrousSigmaPosition = 1.f;
