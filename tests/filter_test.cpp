@@ -190,7 +190,8 @@ TEST(MaafFilter, SeparableAccumulationEqualsDirectEq22) {
     const int W = 9, H = 7, S = 5, pairs = 3;
     Plane pl(W, H);
     MaafPixel params = uniformParams(pairs, true);
-    Image<MaafPixel> pimg(W, H, params);
+    Image<MaafPixel> stored(W, H, params);
+    MaafEffect pimg(stored);
     MaafOptions o;
     o.pairs = pairs;
     o.maxRadius = 20;  // the whole tiny image is inside every window
@@ -243,7 +244,8 @@ TEST(MaafFilter, ConstantSignalStaysConstantAndNoNan) {
     const int W = 24, H = 20, pairs = 3;
     Plane pl(W, H);
     MaafPixel params = uniformParams(pairs, true);
-    Image<MaafPixel> pimg(W, H, params);
+    Image<MaafPixel> stored(W, H, params);
+    MaafEffect pimg(stored);
     MaafOptions o;
     o.pairs = pairs;
     MaafAccumulator acc(pimg, pairs, 1);

@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include <memory>
+
 #include "core/parallel.h"
 #include "filter/maaf_components.h"
 
@@ -96,10 +98,27 @@ MaafAxis buildAxis(const AxisInputs& in, const MaafOptions& o) {
 
 }  // namespace
 
+MaafEffect::MaafEffect(int width, int height, Compute compute)
+    : m_width(width), m_height(height), m_compute(std::move(compute)), m_central(size_t(width) * height) {
+    parallelRows(height, [&](int y) {
+        for (int x = 0; x < width; ++x) {
+            size_t p = size_t(y) * width + x;
+            for (int k = 0; k < 2; ++k) {
+                MaafAxis a;
+                m_compute(p, k, a);
+                m_central[p].sx[k] = a.sx[0];
+                m_central[p].pairs[k] = uint8_t(a.pairs);
+            }
+        }
+    });
+}
+
+MaafEffect::MaafEffect(const Image<MaafPixel>& params)
+    : MaafEffect(params.width(), params.height(), [&params](size_t p, int k, MaafAxis& out) { out = params[p].axis[k]; }) {}
+
 MaafParams maafParams(const FrameBuffers& fb, const WedgeField& wf, const FilterFrames& frames, const ViewGeometry& view,
                       const MaafOptions& o) {
     const int W = fb.width, H = fb.height;
-    MaafParams mp{Image<MaafPixel>(W, H, NoInit{}), Image<MaafPixel>(W, H, NoInit{}), Image1f(W, H)};
     float sigma = kInf;
     const ViewGeometry::Light* smallest = nullptr;  // the most demanding light sets the direct wedge
     for (auto& l : view.lights)
@@ -108,51 +127,70 @@ MaafParams maafParams(const FrameBuffers& fb, const WedgeField& wf, const Filter
             smallest = &l;
         }
     const bool lens = view.apertureRadius > 0;
+    Image1f fallback(W, H);
     parallelRows(H, [&](int y) {
         for (int x = 0; x < W; ++x) {
             size_t p = size_t(y) * W + x;
-            if (fb.object[p] < 0) {
-                mp.direct[p] = MaafPixel{};
-                mp.indirect[p] = MaafPixel{};
-                for (int k = 0; k < 2; ++k) mp.direct[p].axis[k].pairs = mp.indirect[p].axis[k].pairs = 1;
-                continue;
-            }
-            bool fallback = o.focalFallback && lens &&
-                            (wf.focalStraddle[p] > 0 || (wf.suMin[p] < 0 && wf.suMax[p] > 0));
-            mp.fallback[p] = fallback ? 1.f : 0.f;
-            float d = std::max(fb.footprint[p], 1e-12f);
-            for (int k = 0; k < 2; ++k) {
-                AxisInputs in;
-                in.lens = lens;
-                in.omegaU = o.lensOmega;
-                in.fallback = fallback;
-                // Direct: shadow wedge in the light plane.
-                in.step = frames.direct[p].step[k];
-                in.yWedge = wf.s2[p] < kInf;
-                in.omegaY = o.mu / sigma;
-                in.sMin = std::max(wf.s2[p], 1e-4f);
-                in.sMax = std::max(wf.s1[p], wf.s2[p]);
-                in.suMin = wf.suMin[p] * in.step;
-                in.suMax = wf.suMax[p] * in.step;
-                const Vec3f& axis = frames.direct[p].axis[k];
-                in.edge1 = smallest ? std::abs(dot(smallest->edge1, axis)) : 0.0;
-                in.edge2 = smallest ? std::abs(dot(smallest->edge2, axis)) : 0.0;
-                in.light = true;
-                mp.direct[p].axis[k] = buildAxis(in, o);
-                in.light = false;  // the bounce: a cosine-weighted direction
-                // Indirect: bounce wedge in the tangent plane (z clamped to two pixel sizes).
-                in.step = frames.indirect[p].step[k];
-                in.yWedge = wf.zMin[p] < kInf;
-                in.omegaY = o.indirectOmega;
-                in.sMin = std::max(wf.zMin[p], o.zMinPixels * d);
-                in.sMax = std::max(wf.zMax[p], float(in.sMin));
-                in.suMin = wf.suMin[p] * in.step;
-                in.suMax = wf.suMax[p] * in.step;
-                mp.indirect[p].axis[k] = buildAxis(in, o);
-            }
+            fallback[p] = fb.object[p] >= 0 && o.focalFallback && lens &&
+                                  (wf.focalStraddle[p] > 0 || (wf.suMin[p] < 0 && wf.suMax[p] > 0))
+                              ? 1.f
+                              : 0.f;
         }
     });
-    return mp;
+    // The planes the components read that the renderer rewrites after adaptive sampling are
+    // copied, so that a pixel's components stay those its accumulations were laid out for.
+    struct Snapshot {
+        Image1f object, footprint, fallback;
+    };
+    auto snap = std::make_shared<Snapshot>(Snapshot{fb.object, fb.footprint, fallback});
+    auto common = [snap, lens, o](size_t p, AxisInputs& in) {
+        if (snap->object[p] < 0) return false;
+        in.lens = lens;
+        in.omegaU = o.lensOmega;
+        in.fallback = snap->fallback[p] > 0;
+        return true;
+    };
+    // Direct: the shadow wedge in the light plane.
+    auto direct = [&, common, sigma, smallest, o](size_t p, int k, MaafAxis& out) {
+        AxisInputs in;
+        if (!common(p, in)) {
+            out = MaafAxis{};
+            out.pairs = 1;
+            return;
+        }
+        in.step = frames.direct[p].step[k];
+        in.yWedge = wf.s2[p] < kInf;
+        in.omegaY = o.mu / sigma;
+        in.sMin = std::max(wf.s2[p], 1e-4f);
+        in.sMax = std::max(wf.s1[p], wf.s2[p]);
+        in.suMin = wf.suMin[p] * in.step;
+        in.suMax = wf.suMax[p] * in.step;
+        const Vec3f& axis = frames.direct[p].axis[k];
+        in.light = true;
+        in.edge1 = smallest ? std::abs(dot(smallest->edge1, axis)) : 0.0;
+        in.edge2 = smallest ? std::abs(dot(smallest->edge2, axis)) : 0.0;
+        out = buildAxis(in, o);
+    };
+    // Indirect: the bounce wedge in the tangent plane (z clamped to zMinPixels pixel sizes);
+    // the bounce is a cosine-weighted direction.
+    auto indirect = [&, common, snap, o](size_t p, int k, MaafAxis& out) {
+        AxisInputs in;
+        if (!common(p, in)) {
+            out = MaafAxis{};
+            out.pairs = 1;
+            return;
+        }
+        float d = std::max(snap->footprint[p], 1e-12f);
+        in.step = frames.indirect[p].step[k];
+        in.yWedge = wf.zMin[p] < kInf;
+        in.omegaY = o.indirectOmega;
+        in.sMin = std::max(wf.zMin[p], o.zMinPixels * d);
+        in.sMax = std::max(wf.zMax[p], float(in.sMin));
+        in.suMin = wf.suMin[p] * in.step;
+        in.suMax = wf.suMax[p] * in.step;
+        out = buildAxis(in, o);
+    };
+    return MaafParams{MaafEffect(W, H, direct), MaafEffect(W, H, indirect), std::move(fallback)};
 }
 
 namespace {
@@ -237,17 +275,17 @@ void indirectCoordinates(const SampleRecord& s, const AxisFrame& frame, float y[
     u[1] = -s.lens.y;
 }
 
-MaafAccumulator::MaafAccumulator(const Image<MaafPixel>& params, int pairs, int values)
+MaafAccumulator::MaafAccumulator(const MaafEffect& params, int pairs, int values)
     : m_width(params.width()), m_height(params.height()), m_pairs(pairs), m_maxBands(2 * pairs - 1), m_values(values),
       m_channels(values + 1) {
-    const size_t n = params.size();
+    const size_t n = size_t(params.width()) * params.height();
     m_bands1.resize(n);
     m_bands2.resize(n);
     m_offset.resize(n + 1);
     size_t total = 0;
     for (size_t p = 0; p < n; ++p) {
-        m_bands1[p] = uint8_t(2 * std::min(params[p].axis[0].pairs, pairs) - 1);
-        m_bands2[p] = uint8_t(2 * std::min(params[p].axis[1].pairs, pairs) - 1);
+        m_bands1[p] = uint8_t(2 * std::min(params.pairs(p, 0), pairs) - 1);
+        m_bands2[p] = uint8_t(2 * std::min(params.pairs(p, 1), pairs) - 1);
         m_offset[p] = total;
         total += size_t(m_bands1[p]) * m_bands2[p] * size_t(m_channels);
     }
@@ -310,11 +348,11 @@ int windowRadius(const MaafAxis& ax, float step, int maxRadius) {
 
 /// Neighbour test shared by both passes; on success gives the signed offset a (output minus
 /// input, along `axis` of the output pixel's frame) and the in-plane distance r.
-bool neighbour(const FrameBuffers& fb, const Image<MaafPixel>& params, const AxisFrame& f, size_t p, size_t q, int axis,
+bool neighbour(const FrameBuffers& fb, const MaafEffect& params, const AxisFrame& f, size_t p, size_t q, int axis,
                const MaafOptions& o, float& a, float& r) {
     if (q != p) {
         if (!sameSurface(fb, p, q, o.normalCos)) return false;
-        float wp = params[p].axis[axis].sx[0], wq = params[q].axis[axis].sx[0];
+        float wp = params.centralSx(p, axis), wq = params.centralSx(q, axis);
         if (wp > o.bandwidthRatio * wq || wq > o.bandwidthRatio * wp) return false;
         Vec3f dP = fb.position[p] - fb.position[q];
         if (std::abs(dot(dP, fb.normal[p])) > o.planeDistance * fb.footprint[p]) return false;
@@ -335,10 +373,10 @@ struct Window {
     bool ok[2 * kMaxRadius + 1];
     float a[2 * kMaxRadius + 1], r[2 * kMaxRadius + 1];
 
-    Window(const FrameBuffers& fb, const Image<MaafPixel>& params, const AxisFrame& f, int x, int y, int axis,
-           const MaafOptions& o) {
+    Window(const FrameBuffers& fb, const MaafEffect& params, const MaafAxis& own, const AxisFrame& f, int x, int y,
+           int axis, const MaafOptions& o) {
+        radius = std::min(windowRadius(own, f.step[axis], o.maxRadius), kMaxRadius);
         const size_t p = size_t(y) * fb.width + x;
-        radius = std::min(windowRadius(params[p].axis[axis], f.step[axis], o.maxRadius), kMaxRadius);
         for (int k = -radius; k <= radius; ++k) {
             int xx = axis == 0 ? x + k : x, yy = axis == 0 ? y : y + k;
             ok[k + radius] = xx >= 0 && xx < fb.width && yy >= 0 && yy < fb.height &&
@@ -349,7 +387,7 @@ struct Window {
 
 }  // namespace
 
-Image3f MaafAccumulator::filter(const Image<MaafPixel>& params, const FrameBuffers& fb, const Image<AxisFrame>& frames,
+Image3f MaafAccumulator::filter(const MaafEffect& params, const FrameBuffers& fb, const Image<AxisFrame>& frames,
                                 const Image3f& fallback, const MaafOptions& o) const {
     const int W = m_width, H = m_height, B = m_maxBands, C = m_channels, V = m_values;
     const size_t istride = size_t(B + 1) * C;  // B bands of axis 2, plus the central-only band
@@ -363,10 +401,10 @@ Image3f MaafAccumulator::filter(const Image<MaafPixel>& params, const FrameBuffe
         for (int x = 0; x < W; ++x) {
             size_t p = size_t(y) * W + x;
             if (fb.object[p] < 0) continue;
-            const MaafAxis& ax = params[p].axis[0];
+            const MaafAxis ax = params.axis(p, 0);
             const AxisFrame& f = frames[p];
             float* out = &inter[p * istride];
-            const Window win(fb, params, f, x, y, 0, o);
+            const Window win(fb, params, ax, f, x, y, 0, o);
             const int radius = win.radius;
             for (int k = -radius; k <= radius; ++k) {
                 if (!win.ok[k + radius]) continue;
@@ -406,10 +444,10 @@ Image3f MaafAccumulator::filter(const Image<MaafPixel>& params, const FrameBuffe
                 result[p] = fallback[p];
                 continue;
             }
-            const MaafAxis& ax = params[p].axis[1];
+            const MaafAxis ax = params.axis(p, 1);
             const AxisFrame& f = frames[p];
             float h[4] = {0, 0, 0, 0}, h0[4] = {0, 0, 0, 0};  // values..., weight (C <= 4)
-            const Window win(fb, params, f, x, y, 1, o);
+            const Window win(fb, params, ax, f, x, y, 1, o);
             const int radius = win.radius;
             for (int k = -radius; k <= radius; ++k) {
                 if (!win.ok[k + radius]) continue;

@@ -62,6 +62,7 @@
 
 
 #include <cstddef>
+#include <functional>
 #include <type_traits>
 #include <vector>
 
@@ -111,12 +112,48 @@ struct MaafOptions {
     bool symmetricOuter = true;      // outer components only where a neighbour's mirror is accepted too
 };
 
+/// One effect's components for every pixel, computed on demand: a MaafPixel is 232 bytes, and
+/// storing one per pixel and effect cost a 720x720 render 240 MB of freshly zeroed pages (7% of
+/// its CPU time, `perf record`), more than computing them three times. Kept per pixel: what the
+/// neighbours of a pixel and the accumulator's layout need (the central width and component
+/// count of each axis, 12 bytes).
+class MaafEffect {
+public:
+    /// Writes pixel p's components along axis k.
+    using Compute = std::function<void(size_t p, int k, MaafAxis& out)>;
+    MaafEffect(int width, int height, Compute compute);
+    /// Stored parameters (tests, tiny images); `params` must outlive this.
+    explicit MaafEffect(const Image<MaafPixel>& params);
+
+    int width() const { return m_width; }
+    int height() const { return m_height; }
+    MaafAxis axis(size_t p, int k) const {
+        MaafAxis a;
+        m_compute(p, k, a);
+        return a;
+    }
+    MaafPixel pixel(size_t p) const { return MaafPixel{{axis(p, 0), axis(p, 1)}}; }
+    /// sx[0] of pixel p along axis k (the central component's spatial bandwidth).
+    float centralSx(size_t p, int k) const { return m_central[p].sx[k]; }
+    int pairs(size_t p, int k) const { return m_central[p].pairs[k]; }
+
+private:
+    struct Central {
+        float sx[2];
+        uint8_t pairs[2];
+    };
+    int m_width, m_height;
+    Compute m_compute;
+    LargeVector<Central> m_central;
+};
+
 struct MaafParams {
-    Image<MaafPixel> direct, indirect;
+    MaafEffect direct, indirect;
     Image1f fallback;  // 1 where the pixel uses the central component only (focal plane)
 };
 
-/// Components for every pixel, effect and axis.
+/// Components for every pixel, effect and axis. The result refers to fb, wedges, frames and
+/// view, which must outlive it.
 MaafParams maafParams(const FrameBuffers& fb, const WedgeField& wedges, const FilterFrames& frames,
                       const ViewGeometry& view, const MaafOptions& options);
 
@@ -127,7 +164,7 @@ MaafParams maafParams(const FrameBuffers& fb, const WedgeField& wedges, const Fi
 /// own components use ((2 N_1 - 1) x (2 N_2 - 1)), so memory and work follow the wedge.
 class MaafAccumulator {
 public:
-    MaafAccumulator(const Image<MaafPixel>& params, int pairs, int values);
+    MaafAccumulator(const MaafEffect& params, int pairs, int values);
     /// Upper bound of the memory for every pixel using all components (for the memory check).
     static size_t bytes(int width, int height, int pairs, int values) {
         return size_t(width) * height * size_t(sqr(2 * pairs - 1)) * size_t(values + 1) * sizeof(float);
@@ -145,7 +182,7 @@ public:
 
     /// Eq. 21 on image x then image y: the filtered values divided by the filtered weight (one
     /// value channel is replicated to rgb). Pixels without a surface or weight keep `fallback`.
-    Image3f filter(const Image<MaafPixel>& params, const FrameBuffers& fb, const Image<AxisFrame>& frames,
+    Image3f filter(const MaafEffect& params, const FrameBuffers& fb, const Image<AxisFrame>& frames,
                    const Image3f& fallback, const MaafOptions& options) const;
 
 private:

@@ -55,19 +55,21 @@ void renderMaaf(const MethodContext& ctx, RenderResult& result) {
         throw Error("--maaf-components", "expected 1, 3, 5 or 7 components");
 
     // Memory: two accumulators (direct, indirect), the initial sample records, per-pixel
-    // parameters. Refuse before allocating more than the machine has.
+    // central widths, the filter's intermediate bands. Refuse before allocating more than the
+    // machine has (and again before the adaptive samples' records).
     const size_t pixels = size_t(W) * H;
     const size_t accBytes = filter::MaafAccumulator::bytes(W, H, mo.pairs, 1) + filter::MaafAccumulator::bytes(W, H, mo.pairs, 3);
     const size_t recordBytes = pixels * n0 * sizeof(filter::MaafSample);
-    const size_t otherBytes = pixels * (2 * sizeof(filter::MaafPixel) + sizeof(PixelStats) +
-                                        size_t(2 * mo.pairs) * 4 * sizeof(float) + 256);
-    const size_t need = accBytes + recordBytes + otherBytes;
-    const size_t avail = availableMemory();
-    if (avail > 0 && need > avail)
-        throw Error("--method maaf", "needs " + std::to_string(need >> 20) + " MiB at " + std::to_string(W) + "x" +
-                                         std::to_string(H) + " with " + std::to_string(2 * mo.pairs - 1) +
-                                         " components and " + std::to_string(n0) + " initial spp, but only " +
-                                         std::to_string(avail >> 20) + " MiB are available");
+    const size_t otherBytes = pixels * (sizeof(PixelStats) + size_t(2 * mo.pairs) * 6 * sizeof(float) + 256);
+    auto checkMemory = [&](size_t need, const char* what) {
+        const size_t avail = availableMemory();
+        if (avail > 0 && need > avail)
+            throw Error("--method maaf", "needs " + std::to_string(need >> 20) + " MiB more for the " + what + " at " +
+                                             std::to_string(W) + "x" + std::to_string(H) + " with " +
+                                             std::to_string(2 * mo.pairs - 1) + " components and " + std::to_string(n0) +
+                                             " initial spp, but only " + std::to_string(avail >> 20) + " MiB are available");
+    };
+    checkMemory(accBytes + recordBytes + otherBytes, "accumulations and sample records");
     result.extra.emplace_back("maaf_components", double(2 * mo.pairs - 1));
     result.extra.emplace_back("maaf_accumulator_bytes_bound", double(accBytes));
     result.extra.emplace_back("maaf_sample_record_bytes", double(recordBytes));
@@ -114,65 +116,76 @@ void renderMaaf(const MethodContext& ctx, RenderResult& result) {
     }
     result.seconds.add("prefilter_slopes", t.seconds());
 
-    // 2b. Accumulation of eq. 23 over the initial samples on each pixel's primary surface.
+    // 3. Adaptive sampling at the focal plane; its samples are kept as records too, so that each
+    // pixel's components are computed once, when all of its samples are accumulated.
     t.reset();
-    filter::MaafAccumulator accDirect(params.direct, mo.pairs, 1), accIndirect(params.indirect, mo.pairs, 3);
-    result.extra.emplace_back("maaf_accumulator_bytes", double(accDirect.allocatedBytes() + accIndirect.allocatedBytes()));
-    std::vector<uint32_t> counted(pixels, 0);
-    auto accumulate = [&](size_t p, const SampleRecord& r) {
-        float y[2], u[2];
-        filter::directCoordinates(r, frames.direct[p], view, y, u);
-        float visibility = r.unoccluded > 0 ? luminance(r.direct) / r.unoccluded : 0.f;  // 0 or 1
-        accDirect.add(p, &visibility, r.unoccluded, y, u, params.direct[p]);
-        filter::indirectCoordinates(r, frames.indirect[p], y, u);
-        accIndirect.add(p, &r.indirect.x, 1.f, y, u, params.indirect[p]);
-        ++counted[p];
-    };
-    parallelRows(H, [&](int y) {
-        for (int x = 0; x < W; ++x) {
-            size_t p = size_t(y) * W + x;
-            int primary = stats[p].primary();
-            for (uint32_t i = 0; i < n0; ++i)
-                if (records[p * n0 + i].slot == primary) accumulate(p, records[p * n0 + i].unpack(view));
-        }
-    });
-    records.clear();
-    records.shrink_to_fit();
-    result.seconds.add("prefilter_accumulation", t.seconds());
-
-    // 3. Adaptive sampling at the focal plane, accumulated as it is traced.
-    t.reset();
+    std::vector<uint64_t> extraOffset(pixels + 1, 0);
+    for (size_t i = 0; i < pixels; ++i) extraOffset[i + 1] = extraOffset[i] + extra[i];
+    checkMemory(extraTotal * sizeof(filter::MaafSample), "adaptive sample records");
+    LargeVector<filter::MaafSample> extraRecords(extraTotal);
     {
         Progress progress("maaf adaptive", extraTotal, !ctx.options.quiet && extraTotal > 0);
+        std::vector<uint32_t> fill(pixels, 0);
         result.rays += samplePixels(
             ctx.sampler, stats, view, [&](int x, int y) { return SampleRange{n0, extra(x, y)}; }, false, false,
             [&](int x, int y, const TracedSample& s, int slot) {
                 size_t p = size_t(y) * W + x;
-                if (slot >= 0 && slot == stats[p].primary()) accumulate(p, s.record);
+                extraRecords[extraOffset[p] + fill[p]++] = filter::MaafSample::pack(s.record, view, slot);
             },
             &progress);
     }
     storeStats(stats, ctx, fb);
     result.seconds.add("sampling_adaptive", t.seconds());
     result.seconds.add("sampling", result.seconds.get("sampling_initial") + result.seconds.get("sampling_adaptive"));
+
+    // 2b. Accumulation of eq. 23 over the samples on each pixel's primary surface, as means.
+    t.reset();
+    filter::MaafAccumulator accDirect(params.direct, mo.pairs, 1), accIndirect(params.indirect, mo.pairs, 3);
+    result.extra.emplace_back("maaf_accumulator_bytes", double(accDirect.allocatedBytes() + accIndirect.allocatedBytes()));
+    parallelRows(H, [&](int y) {
+        for (int x = 0; x < W; ++x) {
+            size_t p = size_t(y) * W + x;
+            const int primary = stats[p].primary();
+            const filter::MaafPixel direct = params.direct.pixel(p), indirect = params.indirect.pixel(p);
+            const filter::AxisFrame &frameDirect = frames.direct[p], &frameIndirect = frames.indirect[p];
+            uint32_t counted = 0;
+            auto accumulate = [&](const filter::MaafSample& m) {
+                if (m.slot != primary) return;
+                const SampleRecord r = m.unpack(view);
+                float y[2], u[2];
+                filter::directCoordinates(r, frameDirect, view, y, u);
+                float visibility = r.unoccluded > 0 ? luminance(r.direct) / r.unoccluded : 0.f;  // 0 or 1
+                accDirect.add(p, &visibility, r.unoccluded, y, u, direct);
+                filter::indirectCoordinates(r, frameIndirect, y, u);
+                accIndirect.add(p, &r.indirect.x, 1.f, y, u, indirect);
+                ++counted;
+            };
+            for (uint32_t i = 0; i < n0; ++i) accumulate(records[p * n0 + i]);
+            for (uint64_t i = extraOffset[p]; i < extraOffset[p + 1]; ++i) accumulate(extraRecords[i]);
+            if (counted > 0) {
+                accDirect.scale(p, 1.f / float(counted));
+                accIndirect.scale(p, 1.f / float(counted));
+            }
+        }
+    });
+    records = {};
+    extraRecords = {};
+    result.seconds.add("prefilter_accumulation", t.seconds());
     result.seconds.add("prefilter",
                        result.seconds.get("prefilter_slopes") + result.seconds.get("prefilter_accumulation"));
 
     // 4. Filter (eq. 21 on both axes), direct and indirect separately, then remodulate.
     t.reset();
-    parallelRows(H, [&](int y) {
-        for (int x = 0; x < W; ++x) {
-            size_t p = size_t(y) * W + x;
-            if (counted[p] > 0) {
-                accDirect.scale(p, 1.f / float(counted[p]));
-                accIndirect.scale(p, 1.f / float(counted[p]));
-            }
-        }
-    });
     // Direct light as in AAF (report eq. 3.2): filtered visibility x closed-form unoccluded light.
+    Timer part;
     Image3f visibility = accDirect.filter(params.direct, fb, frames.direct, visibilityImage(fb), mo);
+    result.seconds.add("filter_direct", part.seconds());
+    part.reset();
     Image3f indirect = accIndirect.filter(params.indirect, fb, frames.indirect, fb.indirect, mo);
+    result.seconds.add("filter_indirect", part.seconds());
+    part.reset();
     result.color = composeFilteredLight(fb, view, visibility, indirect);
+    result.seconds.add("filter_compose", part.seconds());  // remodulation and the defocus filter
     result.seconds.add("filter", t.seconds());
 
     if (!ctx.options.aovDir.empty()) {
@@ -181,8 +194,8 @@ void renderMaaf(const MethodContext& ctx, RenderResult& result) {
         for (size_t i = 0; i < pixels; ++i) {
             width[i] = fb.object[i] < 0 ? 0.f
                                         : std::min(float(mo.maxRadius),
-                                                   1.f / (params.direct[i].axis[0].sx[0] * frames.direct[i].step[0]));
-            components[i] = fb.object[i] < 0 ? 0.f : float(2 * params.direct[i].axis[0].pairs - 1);
+                                                   1.f / (params.direct.centralSx(i, 0) * frames.direct[i].step[0]));
+            components[i] = fb.object[i] < 0 ? 0.f : float(2 * params.direct.pairs(i, 0) - 1);
         }
         writeAov(dir, "maaf_central_width_direct", width, 0, float(mo.maxRadius));
         writeAov(dir, "maaf_components_direct", components, 0, float(2 * mo.pairs - 1));
