@@ -8,6 +8,7 @@
 
 #include "core/parallel.h"
 #include "render/camera.h"
+#include "render/pixel_stats.h"
 #include "render/renderer.h"
 #include "scene/scene.h"
 #include "scene/scene_loader.h"
@@ -190,4 +191,39 @@ TEST(Render, ImageIsBitIdenticalOnOneAndTwoThreads) {
         EXPECT_EQ(0, std::memcmp(r1.color.data(), r2.color.data(), r1.color.size() * sizeof(Vec3f))) << method;
         EXPECT_EQ(0, std::memcmp(r1.buffers.direct.data(), r2.buffers.direct.data(), r1.color.size() * sizeof(Vec3f)));
     }
+}
+
+namespace {
+/// A path sample on surface `object` at depth 1 with the given direct light (albedo 1).
+render::TracedSample surfaceSample(uint32_t object, float light) {
+    render::TracedSample s;
+    s.hit = true;
+    s.object = object;
+    s.albedo = Vec3f(1.f);
+    s.normal = {0, 0, 1};
+    s.position = {0, 0, object == 0 ? 0.f : 1.f};
+    s.depth = 1;
+    s.record.direct = Vec3f(light);
+    return s;
+}
+}  // namespace
+
+TEST(Render, MixedPixelsAreToppedUpByTheirRelativeVariance) {
+    ViewGeometry view;
+    view.focalPixels = 100;
+    render::PixelStats one, mixed, alike, bright;
+    for (int i = 0; i < 16; ++i) {
+        one.add(surfaceSample(0, 1.f), view, false);
+        mixed.add(surfaceSample(i % 2, i % 2 ? 1.f : 0.05f), view, false);   // an edge with contrast
+        alike.add(surfaceSample(i % 2, 0.5f), view, false);                  // two surfaces, same light
+        bright.add(surfaceSample(i % 4 == 0, i % 4 == 0 ? 20.f : 0.f), view, false);  // a small bright part
+    }
+    EXPECT_EQ(one.mixedTopUp(0.01f, 64), 0u);    // one surface: the filters reach it
+    EXPECT_EQ(alike.mixedTopUp(0.01f, 64), 0u);  // no variance to remove
+    // var / (mean^2 + 0.01) = 0.226 / 0.289 -> 78 samples at tau 0.01, capped at 64 in all.
+    EXPECT_EQ(mixed.mixedTopUp(0.01f, 64), 48u);
+    EXPECT_EQ(mixed.mixedTopUp(0.05f, 64), 0u);  // 15.6 samples: already 16
+    EXPECT_EQ(mixed.mixedTopUp(0.01f, 16), 0u);  // the cap counts every sample
+    EXPECT_GT(bright.mixedTopUp(0.05f, 1024), 16u);
+    EXPECT_EQ(one.primary(), 0);
 }

@@ -46,7 +46,7 @@ void renderAaf(const MethodContext& ctx, RenderResult& result) {
     for (size_t i = 0; i < extra.size(); ++i) {
         float need = std::max({params.sppDirect[i], params.sppIndirect[i], params.sppLens[i]});
         extra[i] = std::max(uint32_t(std::clamp(int(std::ceil(need)) - int(n0), 0, cap)),
-                            stats[i].emitterTopUp(kEmitterEdgeSpp));
+                            std::max(stats[i].emitterTopUp(kEmitterEdgeSpp), stats[i].mixedTopUp(kMixedTau, kMixedSpp)));
         extraTotal += extra[i];
     }
     result.seconds.add("prefilter", t.seconds());

@@ -111,7 +111,7 @@ void renderMaaf(const MethodContext& ctx, RenderResult& result) {
         // AAF (MYRD14) rates, since there the filter is the central, axis-aligned one.
         float need = params.fallback[i] > 0 ? std::max({rates.sppDirect[i], rates.sppIndirect[i], rates.sppLens[i]}) : 0.f;
         extra[i] = std::max(uint32_t(std::clamp(int(std::ceil(need)) - int(n0), 0, cap)),
-                            stats[i].emitterTopUp(kEmitterEdgeSpp));
+                            std::max(stats[i].emitterTopUp(kEmitterEdgeSpp), stats[i].mixedTopUp(kMixedTau, kMixedSpp)));
         extraTotal += extra[i];
     }
     result.seconds.add("prefilter_slopes", t.seconds());

@@ -10,6 +10,8 @@
 // kept as an unfiltered colour (FrameBuffers::rest).
 #pragma once
 
+#include <algorithm>
+
 #include "core/buffers.h"
 #include "render/path_sampler.h"
 
@@ -54,6 +56,16 @@ struct PixelStats {
     /// reach emitted light, and a bright edge seen by few samples dominates any relative error.
     uint32_t emitterTopUp(uint32_t target) const {
         return (nEmitter > 0 && nEmitter < n && n < target) ? target - n : 0;
+    }
+    /// Extra samples for a pixel whose samples saw more than one surface (or a surface and the
+    /// background): no per-surface filter reaches how they mix, so such a pixel is sampled until
+    /// the relative variance of its mean, var / ((mean^2 + 0.01) n), falls to `tau`, at most up
+    /// to `target` samples in all.
+    uint32_t mixedTopUp(float tau, uint32_t target) const {
+        if (n == 0 || slot[0].n == n || n >= target) return 0;
+        float mean = lumSum / float(n), var = std::max(0.f, lumSq / float(n) - mean * mean);
+        float need = var / ((mean * mean + 0.01f) * tau);
+        return need > float(n) ? uint32_t(std::min(need, float(target))) - n : 0;
     }
     /// Writes this pixel into every plane of `fb`.
     void store(FrameBuffers& fb, int x, int y, const ViewGeometry& view) const;
