@@ -428,3 +428,43 @@ TEST(MaafWeights, SamplingSpectraRemoveMostOfTheOuterComponentsBias) {
         EXPECT_LT(aaf, sampling) << "aspect " << aspect;
     }
 }
+
+TEST(MaafSample, PackedSampleGivesTheRecordsCoordinates) {
+    // The 36-byte record MAAF keeps until accumulation: its coordinates along a pixel's frames
+    // match the full sample's within the unorm16 / octahedral quantisation.
+    ViewGeometry view;
+    ViewGeometry::Light l;
+    l.center = {0.2f, 3.f, -0.1f};
+    l.axisA = normalize(Vec3f(1.f, 0.f, 0.2f));
+    l.axisB = normalize(cross(Vec3f(0.f, -1.f, 0.f), l.axisA));
+    view.lights.push_back(l);
+    AxisFrame direct, indirect;
+    direct.axis[0] = normalize(Vec3f(1.f, 0.f, 0.1f));
+    direct.axis[1] = normalize(cross(Vec3f(0.f, 1.f, 0.f), direct.axis[0]));
+    indirect.axis[0] = normalize(Vec3f(0.9f, 0.3f, 0.f));
+    indirect.axis[1] = normalize(Vec3f(-0.3f, 0.9f, 0.2f));
+    std::mt19937 rng(3);
+    std::uniform_real_distribution<float> U(-1.f, 1.f);
+    for (int i = 0; i < 200; ++i) {
+        SampleRecord r;
+        r.light = 0;
+        r.lightPoint = l.center + l.axisA * (0.3f * U(rng)) + l.axisB * (0.3f * U(rng));
+        r.unoccluded = 0.5f + 0.5f * U(rng);
+        r.direct = Vec3f(i % 3 ? r.unoccluded : 0.f);
+        r.indirect = {0.1f, 0.2f, 0.3f};
+        r.lens = {0.7f * U(rng), 0.7f * U(rng)};
+        r.bounceDir = normalize(Vec3f(U(rng), U(rng), U(rng)));
+        MaafSample m = MaafSample::pack(r, view, 1);
+        float yD[2], yI[2], u[2];
+        m.coordinates(view, direct, indirect, yD, yI, u);
+        for (int k = 0; k < 2; ++k) {
+            EXPECT_NEAR(yD[k], dot(r.lightPoint - l.center, direct.axis[k]), 1e-5f);
+            EXPECT_NEAR(yI[k], dot(r.bounceDir, indirect.axis[k]), 2e-4f);
+        }
+        EXPECT_NEAR(u[0], r.lens.x, 4e-5f);
+        EXPECT_NEAR(u[1], -r.lens.y, 4e-5f);
+        EXPECT_EQ(m.visibility(), i % 3 ? 1.f : 0.f);
+        EXPECT_EQ(m.unoccluded, r.unoccluded);
+        EXPECT_EQ(m.slot, 1);
+    }
+}

@@ -247,32 +247,17 @@ MaafSample MaafSample::pack(const SampleRecord& r, const ViewGeometry& view, int
     return m;
 }
 
-SampleRecord MaafSample::unpack(const ViewGeometry& view) const {
-    SampleRecord r;
+void MaafSample::coordinates(const ViewGeometry& view, const AxisFrame& direct, const AxisFrame& indirect,
+                             float yDirect[2], float yIndirect[2], float u[2]) const {
     const ViewGeometry::Light& l = view.lights[light];
-    r.light = light;
-    r.lightPoint = l.center + l.axisA * lightA + l.axisB * lightB;
-    r.unoccluded = unoccluded;
-    r.direct = Vec3f((visible & 1) ? unoccluded : 0.f);  // luminance only: MAAF filters visibility
-    r.indirect = Vec3f(indirect[0], indirect[1], indirect[2]);
-    r.lens = {2.f * fromUnorm16(lens[0]) - 1.f, 2.f * fromUnorm16(lens[1]) - 1.f};
-    r.bounceDir = (visible & 2) ? octDecode(fromUnorm16(bounce[0]), fromUnorm16(bounce[1])) : Vec3f(0.f);
-    return r;
-}
-
-void directCoordinates(const SampleRecord& s, const AxisFrame& frame, const ViewGeometry& view, float y[2], float u[2]) {
-    Vec3f rel = s.lightPoint - view.lights[s.light].center;
-    y[0] = dot(rel, frame.axis[0]);
-    y[1] = dot(rel, frame.axis[1]);
-    u[0] = s.lens.x;
-    u[1] = -s.lens.y;  // lens y is along camera up; axis 2 is image down
-}
-
-void indirectCoordinates(const SampleRecord& s, const AxisFrame& frame, float y[2], float u[2]) {
-    y[0] = dot(s.bounceDir, frame.axis[0]);
-    y[1] = dot(s.bounceDir, frame.axis[1]);
-    u[0] = s.lens.x;
-    u[1] = -s.lens.y;
+    const Vec3f bounceDir =
+        (visible & 2) ? octDecode(fromUnorm16(bounce[0]), fromUnorm16(bounce[1])) : Vec3f(0.f);
+    for (int k = 0; k < 2; ++k) {
+        yDirect[k] = lightA * dot(l.axisA, direct.axis[k]) + lightB * dot(l.axisB, direct.axis[k]);
+        yIndirect[k] = dot(bounceDir, indirect.axis[k]);
+    }
+    u[0] = 2.f * fromUnorm16(lens[0]) - 1.f;
+    u[1] = -(2.f * fromUnorm16(lens[1]) - 1.f);  // lens y is along camera up; axis 2 is image down
 }
 
 MaafAccumulator::MaafAccumulator(const MaafEffect& params, int pairs, int values)

@@ -209,13 +209,13 @@ struct MaafSample {
     uint8_t pad;
 
     static MaafSample pack(const SampleRecord& r, const ViewGeometry& view, int slot);
-    /// The record again (direct as visibility x unoccluded luminance, which is all MAAF uses).
-    SampleRecord unpack(const ViewGeometry& view) const;
+    /// What the accumulation needs: the light point relative to the light's centre along the
+    /// direct frame's axes, the bounce direction along the indirect frame's, and the lens
+    /// position along both (lens y is along camera up, axis 2 is image down, hence its sign).
+    void coordinates(const ViewGeometry& view, const AxisFrame& direct, const AxisFrame& indirect, float yDirect[2],
+                     float yIndirect[2], float u[2]) const;
+    float visibility() const { return (visible & 1) ? 1.f : 0.f; }
 };
 static_assert(sizeof(MaafSample) == 36 && std::is_trivially_default_constructible_v<MaafSample>);
-
-/// The secondary and lens coordinates of a sample along a pixel's two axes.
-void directCoordinates(const SampleRecord& s, const AxisFrame& frame, const ViewGeometry& view, float y[2], float u[2]);
-void indirectCoordinates(const SampleRecord& s, const AxisFrame& frame, float y[2], float u[2]);
 
 }  // namespace wedge::filter

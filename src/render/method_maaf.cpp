@@ -151,13 +151,11 @@ void renderMaaf(const MethodContext& ctx, RenderResult& result) {
             uint32_t counted = 0;
             auto accumulate = [&](const filter::MaafSample& m) {
                 if (m.slot != primary) return;
-                const SampleRecord r = m.unpack(view);
-                float y[2], u[2];
-                filter::directCoordinates(r, frameDirect, view, y, u);
-                float visibility = r.unoccluded > 0 ? luminance(r.direct) / r.unoccluded : 0.f;  // 0 or 1
-                accDirect.add(p, &visibility, r.unoccluded, y, u, direct);
-                filter::indirectCoordinates(r, frameIndirect, y, u);
-                accIndirect.add(p, &r.indirect.x, 1.f, y, u, indirect);
+                float yDirect[2], yIndirect[2], u[2];
+                m.coordinates(view, frameDirect, frameIndirect, yDirect, yIndirect, u);
+                const float visibility = m.visibility();
+                accDirect.add(p, &visibility, m.unoccluded, yDirect, u, direct);
+                accIndirect.add(p, m.indirect, 1.f, yIndirect, u, indirect);
                 ++counted;
             };
             for (uint32_t i = 0; i < n0; ++i) accumulate(records[p * n0 + i]);
