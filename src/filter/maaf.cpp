@@ -318,6 +318,12 @@ void MaafAccumulator::add(size_t pixel, const float* value, float weight, const 
     }
 }
 
+void MaafAccumulator::setCentral(size_t pixel, const float* meanValueTimesWeight, float meanWeight) {
+    float* d = &m_data[m_offset[pixel]];
+    for (int c = 0; c < m_values; ++c) d[c] = meanValueTimesWeight[c];
+    d[m_values] = meanWeight;
+}
+
 void MaafAccumulator::scale(size_t pixel, float s) {
     for (size_t i = m_offset[pixel]; i < m_offset[pixel + 1]; ++i) m_data[i] *= s;
 }

@@ -177,6 +177,9 @@ public:
     void add(size_t pixel, const float* value, float weight, const float y[2], const float u[2], const MaafPixel& params);
     /// Divides a pixel's accumulations by its sample count (per-pixel means).
     void scale(size_t pixel, float s);
+    /// Sets the mean of a pixel that uses the central component only on both axes, without
+    /// windows: eq. 23 is then the plain mean of value x weight and of weight.
+    void setCentral(size_t pixel, const float* meanValueTimesWeight, float meanWeight);
     const float* pixel(size_t p) const { return &m_data[m_offset[p]]; }
     int bands(size_t p, int axis) const { return axis == 0 ? m_bands1[p] : m_bands2[p]; }
 

@@ -147,6 +147,21 @@ void renderMaaf(const MethodContext& ctx, RenderResult& result) {
             size_t p = size_t(y) * W + x;
             const int primary = stats[p].primary();
             const filter::MaafPixel direct = params.direct.pixel(p), indirect = params.indirect.pixel(p);
+            // Central component only on both axes (most pixels: the window fit): eq. 23 is the
+            // primary surface's plain sums, which the pixel statistics already hold.
+            auto centralOnly = [&](const filter::MaafPixel& m) {
+                return !mo.apertureWindows && m.axis[0].pairs == 1 && m.axis[1].pairs == 1;
+            };
+            const render::SurfaceSlot& slot = stats[p].slot[primary];
+            if (centralOnly(direct) && centralOnly(indirect)) {
+                if (slot.n > 0) {
+                    const float inv = 1.f / float(slot.n), visible = slot.visible * inv;
+                    const float indirectMean[3] = {slot.indirect.x * inv, slot.indirect.y * inv, slot.indirect.z * inv};
+                    accDirect.setCentral(p, &visible, slot.unoccluded * inv);
+                    accIndirect.setCentral(p, indirectMean, 1.f);
+                }
+                continue;
+            }
             const filter::AxisFrame &frameDirect = frames.direct[p], &frameIndirect = frames.indirect[p];
             uint32_t counted = 0;
             auto accumulate = [&](const filter::MaafSample& m) {
