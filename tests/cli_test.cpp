@@ -135,6 +135,13 @@ TEST(Cli, ObjWithBadFaceIndex) {
                    "face refers to a missing vertex");
 }
 
+TEST(Cli, ObjWithBadNormalIndex) {
+    std::string dir = tempDir();
+    writeFile(dir + "/badvn.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nf 1//1 2//1 3//4\n");
+    expectRejected(scene(R"({"type": "mesh", "file": ")" + dir + R"(/badvn.obj", "material": "white"})"),
+                   "badvn.obj': face refers to a missing normal");
+}
+
 TEST(Cli, NoLight) {
     expectRejected(scene(kSphere, "\"lights\": [{\"type\": \"parallelogram\", \"corner\": [-0.5, 2, -0.5], \"edge1\": [1, 0, 0], \"edge2\": [0, 0, 1], \"radiance\": [5, 5, 5]}]",
                          "\"lights\": []"),
@@ -164,5 +171,5 @@ TEST(Cli, BadFlags) {
 TEST(Cli, ScenesListsBuiltins) {
     std::string out;
     EXPECT_EQ(runWedge("scenes", &out), 0);
-    for (const char* name : {"cornell", "grids", "conference", "sponza"}) EXPECT_NE(out.find(name), std::string::npos) << name;
+    for (const char* name : {"cornell", "grids", "conference", "sponza", "bunny"}) EXPECT_NE(out.find(name), std::string::npos) << name;
 }

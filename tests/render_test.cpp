@@ -12,6 +12,7 @@
 #include "render/renderer.h"
 #include "scene/scene.h"
 #include "scene/scene_loader.h"
+#include "test_util.h"
 
 using namespace wedge;
 
@@ -86,6 +87,37 @@ TEST(Render, PlaneUnderParallelogramMatchesClosedForm) {
         }
     EXPECT_LT(sumRel / n, 0.01) << "mean relative error over the image";
     EXPECT_LT(maxRel, 0.08) << "worst pixel (256 stratified samples)";
+}
+
+TEST(Render, ShadingNormalsOfAnObjSetTheLightCosine) {
+    // The plane of kPlaneScene as an OBJ whose `vn` all lean 30 degrees towards +x: the direct
+    // light follows Lambert's formula for the leaning normal, not the facet's.
+    const std::string dir = test::tempDir();
+    test::writeFile(dir + "/lean.obj",
+                    "v -4 0 4\nv 4 0 4\nv 4 0 -4\nv -4 0 -4\nvn 0.5 0.8660254 0\nf 1//1 2//1 3//1 4//1\n");
+    std::string json = kPlaneScene;
+    const std::string quad = R"({"type": "quad", "corner": [-4, 0, 4], "edge1": [8, 0, 0], "edge2": [0, 0, -8], "material": "grey"})";
+    json.replace(json.find(quad), quad.size(), R"({"type": "mesh", "file": ")" + dir + R"(/lean.obj", "material": "grey"})");
+    render::RenderOptions o;
+    o.quiet = true;
+    render::RenderResult r = renderJson(json, o);
+    std::vector<Vec3f> poly = {{-0.3f, 1, -0.5f}, {0.7f, 1, -0.5f}, {0.7f, 1, 0.5f}, {-0.3f, 1, 0.5f}};
+    const Vec3f lean(0.5f, 0.8660254f, 0.f);
+    double sumRel = 0, sumFlat = 0;
+    int n = 0;
+    for (int y = 0; y < r.color.height(); ++y)
+        for (int x = 0; x < r.color.width(); ++x) {
+            Vec3f p = r.buffers.position(x, y);
+            // The whole light stays above the leaning normal's horizon over the visible plane.
+            double e = 10.0 * polygonIrradiance(p, lean, poly) * kInvPi;
+            double flat = 10.0 * polygonIrradiance(p, {0, 1, 0}, poly) * kInvPi;
+            sumRel += std::abs(r.buffers.direct(x, y).x - e) / e;
+            sumFlat += std::abs(flat - e) / e;
+            EXPECT_NEAR(r.buffers.normal(x, y).x, lean.x, 1e-4f);
+            ++n;
+        }
+    EXPECT_LT(sumRel / n, 0.01) << "mean relative error against the leaning normal's closed form";
+    EXPECT_GT(sumFlat / n, 0.1) << "the test must tell the two normals apart";
 }
 
 TEST(Render, OneBounceInsideSphereMatchesFormFactorClosedForm) {

@@ -94,3 +94,54 @@ TEST(Scene, MotionBlurMovesGeometryOverTheShutter) {
     EXPECT_FALSE(s.intersect({0, 0, 1}, {0, 0, -1}, 0, kInf, 0.5f, h));   // quad now spans x in [0.5, 1.5]
     EXPECT_TRUE(s.intersect({1, 0, 1}, {0, 0, -1}, 0, kInf, 0.5f, h));
 }
+
+TEST(Scene, CornerNormalsAreInterpolatedWithEmbreeBarycentrics) {
+    SceneDesc d;
+    d.materials.push_back({"white", Vec3f(0.5f), Vec3f(0.f), "", 1.f});
+    TriangleMesh m;
+    m.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};  // geometric normal +z
+    m.indices = {0, 1, 2};
+    m.materialIds = {0};
+    m.shapeIds = {0};
+    m.cornerNormals = {normalize(Vec3f(-1, 0, 1)), normalize(Vec3f(1, 0, 1)), normalize(Vec3f(0, 1, 1))};
+    const std::vector<Vec3f> corners = m.cornerNormals;
+    d.meshes.push_back(m);
+    Scene s(std::move(d));
+    Hit h;
+    // Point 0.2 p0 + 0.5 p1 + 0.3 p2.
+    ASSERT_TRUE(s.intersect({0.5f, 0.3f, 2}, {0, 0, -1}, 0, kInf, 0, h));
+    Vec3f expected = normalize(corners[0] * 0.2f + corners[1] * 0.5f + corners[2] * 0.3f);
+    EXPECT_NEAR(h.shadingNormal.x, expected.x, 1e-5f);
+    EXPECT_NEAR(h.shadingNormal.y, expected.y, 1e-5f);
+    EXPECT_NEAR(h.shadingNormal.z, expected.z, 1e-5f);
+    EXPECT_NEAR(h.normal.z, 1.f, 1e-6f) << "the geometric normal stays the facet's";
+    // Flat meshes (quads, boxes) shade with the geometric normal.
+    Scene flat(oneQuad());
+    ASSERT_TRUE(flat.intersect({0.3f, 0.1f, 3}, {0, 0, -1}, 0, kInf, 0, h));
+    EXPECT_NEAR(h.shadingNormal.z, 1.f, 1e-6f);
+}
+
+TEST(Scene, SmoothNormalsBlendShallowFoldsAndKeepCreases) {
+    // Two triangles sharing the edge (0,0,0)-(0,1,0), folded by `fold` degrees about it.
+    auto tent = [](float fold) {
+        TriangleMesh m;
+        float a = fold * kPi / 180.f;
+        m.positions = {{0, 0, 0}, {0, 1, 0}, {-1, 0, 0}, {std::cos(a), 0, std::sin(a)}};
+        m.indices = {0, 1, 2, 0, 3, 1};  // left face normal +z; right face (-sin, 0, cos) of `fold`
+        m.materialIds = {0, 0};
+        m.shapeIds = {0, 0};
+        smoothCornerNormals(m, 60.f);
+        return m;
+    };
+    const TriangleMesh shallow = tent(30.f);
+    ASSERT_EQ(shallow.cornerNormals.size(), 6u);
+    // Both faces have the same area, so a shared corner's normal bisects the fold.
+    Vec3f bisector = normalize(Vec3f(0, 0, 1) + Vec3f(-std::sin(30.f * kPi / 180.f), 0, std::cos(30.f * kPi / 180.f)));
+    for (int i : {0, 1, 3, 5}) {  // corners at the shared vertices 0 and 1
+        EXPECT_NEAR(dot(shallow.cornerNormals[i], bisector), 1.f, 1e-5f) << "corner " << i;
+    }
+    EXPECT_NEAR(shallow.cornerNormals[2].z, 1.f, 1e-6f) << "a vertex of one face keeps that face's normal";
+    const TriangleMesh crease = tent(90.f);  // a box edge
+    for (int i : {0, 1, 2}) EXPECT_NEAR(crease.cornerNormals[i].z, 1.f, 1e-6f) << "corner " << i;
+    for (int i : {3, 4, 5}) EXPECT_NEAR(crease.cornerNormals[i].x, -1.f, 1e-6f) << "corner " << i;
+}

@@ -4,6 +4,13 @@
 
 namespace wedge::render {
 
+namespace {
+
+/// The shading normal on the geometric normal's side (vn may be authored either way round).
+Vec3f facing(const Vec3f& shading, const Vec3f& geometric) { return dot(shading, geometric) < 0 ? -shading : shading; }
+
+}  // namespace
+
 PathSampler::PathSampler(const scene::Scene& scene, const Camera& camera, bool indirect, uint32_t seed)
     : m_scene(scene), m_camera(camera), m_indirect(indirect), m_seed(seed) {
     m_epsilon = 1e-5f * scene.extent();
@@ -71,7 +78,7 @@ void PathSampler::traceBatch(int x, int y, uint32_t first, uint32_t count, bool 
         TracedSample* out = outs + base;
         float time[K], choice[K];
         const scene::Material* mat[K] = {};
-        Vec3f normal[K];
+        Vec3f normal[K], geometric[K];  // shading and geometric normals, on the side the ray came from
         LightSample ls[K], l2[K];
 
         // The batch's random numbers, pair by pair (vectorised across samples). Dimensions that
@@ -112,7 +119,8 @@ void PathSampler::traceBatch(int x, int y, uint32_t first, uint32_t count, bool 
             if (!found[k]) continue;
             mat[k] = &m_scene.material(hit[k].material);
             bool front = dot(hit[k].normal, primary.dir[k]) < 0;
-            normal[k] = front ? hit[k].normal : -hit[k].normal;  // two-sided shading
+            geometric[k] = front ? hit[k].normal : -hit[k].normal;  // two-sided shading
+            normal[k] = facing(hit[k].shadingNormal, geometric[k]);
             TracedSample& o = out[k];
             o.hit = true;
             o.albedo = mat[k]->albedo;
@@ -126,12 +134,18 @@ void PathSampler::traceBatch(int x, int y, uint32_t first, uint32_t count, bool 
             o.record.lightPoint = ls[k].point;
             if (maxComponent(ls[k].irradiance) <= 0) continue;
             o.record.unoccluded = luminance(ls[k].irradiance) * kInvPi;
-            Vec3f org = offset(hit[k].position, normal[k]);
+            o.shadowTested = true;
+            o.d1 = length(lights[ls[k].light].center() - hit[k].position);
+            if (dot(ls[k].toLight, geometric[k]) <= 0) {
+                // Above the shading normal's horizon, below the facet's: the surface shadows
+                // itself (no occluder to take a slope from).
+                o.occluded = o.selfShadowed = true;
+                continue;
+            }
+            Vec3f org = offset(hit[k].position, geometric[k]);
             Vec3f toPoint = ls[k].point - org;
             float dist = length(toPoint);
             shadow.set(k, org, toPoint / dist, dist * (1.f - 1e-4f), time[k]);
-            o.shadowTested = true;
-            o.d1 = length(lights[ls[k].light].center() - hit[k].position);
             ++o.rays;
         }
         if (shadow.any()) {
@@ -139,6 +153,7 @@ void PathSampler::traceBatch(int x, int y, uint32_t first, uint32_t count, bool 
                 scene::OccluderSpan spans[K];
                 m_scene.occluders(shadow, spans);
                 for (int k = 0; k < n; ++k) {
+                    if (!shadow.valid[k]) continue;
                     out[k].occluded = spans[k].occluded;
                     out[k].tNear = spans[k].tNear;
                     out[k].tFar = spans[k].tFar;
@@ -146,7 +161,8 @@ void PathSampler::traceBatch(int x, int y, uint32_t first, uint32_t count, bool 
             } else {
                 bool occ[K];
                 m_scene.occluded(shadow, occ);
-                for (int k = 0; k < n; ++k) out[k].occluded = occ[k];
+                for (int k = 0; k < n; ++k)
+                    if (shadow.valid[k]) out[k].occluded = occ[k];
             }
             for (int k = 0; k < n; ++k)
                 if (shadow.valid[k] && !out[k].occluded) out[k].record.direct = ls[k].irradiance * kInvPi;
@@ -158,8 +174,9 @@ void PathSampler::traceBatch(int x, int y, uint32_t first, uint32_t count, bool 
         for (int k = 0; k < n; ++k) {
             if (!found[k] || maxComponent(mat[k]->albedo) <= 0) continue;
             Vec3f dir = Frame(normal[k]).toWorld(cosineHemisphere(uBounce[k].x, uBounce[k].y));
+            if (dot(dir, geometric[k]) <= 0) continue;  // into the facet: no light comes that way
             out[k].record.bounceDir = dir;
-            bounce.set(k, offset(hit[k].position, normal[k]), dir, kInf, time[k]);
+            bounce.set(k, offset(hit[k].position, geometric[k]), dir, kInf, time[k]);
             ++out[k].rays;
         }
         if (!bounce.any()) continue;
@@ -176,10 +193,10 @@ void PathSampler::traceBatch(int x, int y, uint32_t first, uint32_t count, bool 
             out[k].bounceDistance = h2[k].t;
             m2[k] = &m_scene.material(h2[k].material);
             if (maxComponent(m2[k]->albedo) <= 0) continue;
-            Vec3f n2 = dot(h2[k].normal, bounce.dir[k]) < 0 ? h2[k].normal : -h2[k].normal;
-            l2[k] = sampleLight(h2[k].position, n2, uBounceLight[k], choice[k]);
-            if (maxComponent(l2[k].irradiance) <= 0) continue;
-            Vec3f org2 = offset(h2[k].position, n2);
+            Vec3f g2 = dot(h2[k].normal, bounce.dir[k]) < 0 ? h2[k].normal : -h2[k].normal;
+            l2[k] = sampleLight(h2[k].position, facing(h2[k].shadingNormal, g2), uBounceLight[k], choice[k]);
+            if (maxComponent(l2[k].irradiance) <= 0 || dot(l2[k].toLight, g2) <= 0) continue;
+            Vec3f org2 = offset(h2[k].position, g2);
             Vec3f toPoint = l2[k].point - org2;
             float dist = length(toPoint);
             shadow2.set(k, org2, toPoint / dist, dist * (1.f - 1e-4f), time[k]);

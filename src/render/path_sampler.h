@@ -26,6 +26,7 @@ struct TracedSample {
     uint32_t object = 0;
     // Shadow ray of the primary hit (only when the light faced the receiver).
     bool shadowTested = false, occluded = false;
+    bool selfShadowed = false;     // the light is above the shading normal's horizon but below the facet's
     float d1 = 0;                  // receiver -> light centre
     float tNear = kInf, tFar = 0;  // occluder span along the shadow ray (span queries only)
     // Bounce.

@@ -27,7 +27,7 @@ void SurfaceSlot::add(const TracedSample& s, const ViewGeometry& view, bool slop
     suMax = std::max(suMax, su);
     if (s.shadowTested) {
         ++nShadow;
-        if (s.occluded) {
+        if (s.occluded && !s.selfShadowed) {
             // NOTES (AAF 2012 code): d2min = d1 - t_far, d2max = d1 - t_near, s = d1/d2 - 1.
             ++nOccluded;
             d1Sum += s.d1;

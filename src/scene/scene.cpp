@@ -97,7 +97,8 @@ Scene::Scene(SceneDesc desc) : m_desc(std::move(desc)) {
         unsigned id = rtcAttachGeometry(m_scene, geom);
         rtcReleaseGeometry(geom);  // the scene holds the reference now
         if (m_geometry.size() <= id) m_geometry.resize(id + 1);
-        m_geometry[id] = {mesh.materialIds.data(), mesh.shapeIds.data(), 0, object, false};
+        m_geometry[id] = {mesh.materialIds.data(), mesh.shapeIds.data(), 0, object, false,
+                          mesh.cornerNormals.size() == mesh.indices.size() ? mesh.cornerNormals.data() : nullptr};
         uint32_t shapes = 0;
         for (uint32_t sId : mesh.shapeIds) shapes = std::max(shapes, sId + 1);
         object += std::max(shapes, 1u);
@@ -139,13 +140,21 @@ Scene::~Scene() {
 }
 
 void Scene::fillHit(const Vec3f& org, const Vec3f& dir, float t, unsigned geomID, unsigned primID, const Vec3f& ng,
-                    Hit& hit) const {
+                    float u, float v, Hit& hit) const {
     const GeometryInfo& g = m_geometry[geomID];
     hit.t = t;
     hit.position = org + dir * t;
     // Embree's Ng is the counter-clockwise normal for triangles and points outward for spheres
     // (tests/scene_test.cpp checks both), which is our front side.
     hit.normal = normalize(ng);
+    hit.shadingNormal = hit.normal;
+    if (g.cornerNormals) {
+        // Embree's barycentrics: p = (1 - u - v) p0 + u p1 + v p2.
+        const Vec3f* n = g.cornerNormals + 3 * size_t(primID);
+        Vec3f s = n[0] * (1.f - u - v) + n[1] * u + n[2] * v;
+        float len = length(s);
+        if (len > 0) hit.shadingNormal = s / len;
+    }
     hit.material = g.materialIds ? g.materialIds[primID] : g.material;
     // Spheres: one surface each; meshes: one per shape.
     hit.object = g.object + (g.sphere ? primID : (g.shapeIds ? g.shapeIds[primID] : 0));
@@ -157,7 +166,8 @@ bool Scene::intersect(const Vec3f& org, const Vec3f& dir, float tNear, float tFa
     RTCRayHit rh = makeRayHit(org, dir, tNear, tFar, time);
     rtcIntersect1(m_scene, &ctx, &rh);
     if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
-    fillHit(org, dir, rh.ray.tfar, rh.hit.geomID, rh.hit.primID, Vec3f(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z), hit);
+    fillHit(org, dir, rh.ray.tfar, rh.hit.geomID, rh.hit.primID, Vec3f(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z), rh.hit.u,
+            rh.hit.v, hit);
     return true;
 }
 
@@ -175,7 +185,7 @@ void Scene::intersect(const RayPacket& rays, Hit hits[RayPacket::kSize], bool fo
         found[i] = rays.valid[i] && rh.hit.geomID[i] != RTC_INVALID_GEOMETRY_ID;
         if (found[i])
             fillHit(rays.org[i], rays.dir[i], rh.ray.tfar[i], rh.hit.geomID[i], rh.hit.primID[i],
-                    Vec3f(rh.hit.Ng_x[i], rh.hit.Ng_y[i], rh.hit.Ng_z[i]), hits[i]);
+                    Vec3f(rh.hit.Ng_x[i], rh.hit.Ng_y[i], rh.hit.Ng_z[i]), rh.hit.u[i], rh.hit.v[i], hits[i]);
     }
 }
 

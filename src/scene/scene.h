@@ -17,6 +17,7 @@ struct Hit {
     float t = kInf;
     Vec3f position;
     Vec3f normal;  // unit geometric normal, front side = counter-clockwise winding / sphere outside
+    Vec3f shadingNormal;  // unit interpolated corner normal (meshes that have them), else the geometric one
     uint32_t material = 0;
     uint32_t object = 0;  // surface id: one per mesh shape (OBJ group) or primitive, one per sphere
 };
@@ -75,7 +76,7 @@ public:
 
 private:
     void fillHit(const Vec3f& org, const Vec3f& dir, float t, unsigned geomID, unsigned primID, const Vec3f& ng,
-                 Hit& hit) const;
+                 float u, float v, Hit& hit) const;
 
     struct GeometryInfo {
         const uint32_t* materialIds = nullptr;  // per primitive, or null with a constant material
@@ -83,6 +84,7 @@ private:
         uint32_t material = 0;
         uint32_t object = 0;
         bool sphere = false;
+        const Vec3f* cornerNormals = nullptr;  // 3 per primitive, or null: flat shading
     };
 
     SceneDesc m_desc;

@@ -1,5 +1,7 @@
 #include "scene/scene_desc.h"
 
+#include <cmath>
+
 namespace wedge::scene {
 
 bool SceneDesc::hasMotion() const {
@@ -16,6 +18,45 @@ void appendQuad(TriangleMesh& mesh, const Vec3f& corner, const Vec3f& e1, const 
     mesh.indices.insert(mesh.indices.end(), {base, base + 1, base + 2, base, base + 2, base + 3});
     mesh.materialIds.insert(mesh.materialIds.end(), {material, material});
     mesh.shapeIds.insert(mesh.shapeIds.end(), {0, 0});
+    if (!mesh.cornerNormals.empty()) mesh.cornerNormals.insert(mesh.cornerNormals.end(), 6, normalize(cross(e1, e2)));
+}
+
+void smoothCornerNormals(TriangleMesh& mesh, float creaseDegrees) {
+    const size_t triangles = mesh.triangleCount();
+    if (mesh.cornerNormals.empty()) mesh.cornerNormals.assign(3 * triangles, Vec3f(0.f));
+    // Area-weighted face normals (the cross product's length is twice the area).
+    std::vector<Vec3f> face(triangles);
+    for (size_t t = 0; t < triangles; ++t) {
+        const Vec3f &a = mesh.positions[mesh.indices[3 * t]], &b = mesh.positions[mesh.indices[3 * t + 1]],
+                    &c = mesh.positions[mesh.indices[3 * t + 2]];
+        face[t] = cross(b - a, c - a);
+    }
+    // Triangles around each vertex (compressed adjacency).
+    const size_t vertices = mesh.positions.size();
+    std::vector<uint32_t> start(vertices + 1, 0), around(3 * triangles);
+    for (uint32_t v : mesh.indices) ++start[v + 1];
+    for (size_t v = 0; v < vertices; ++v) start[v + 1] += start[v];
+    std::vector<uint32_t> fill(start.begin(), start.end() - 1);
+    for (size_t i = 0; i < mesh.indices.size(); ++i) around[fill[mesh.indices[i]]++] = uint32_t(i / 3);
+    const float cosCrease = std::cos(creaseDegrees * kPi / 180.f);
+    for (size_t i = 0; i < 3 * triangles; ++i) {
+        if (mesh.cornerNormals[i] != Vec3f(0.f)) continue;
+        const size_t t = i / 3;
+        const float area = length(face[t]);
+        if (area <= 0) {  // degenerate: never hit by a ray, any unit vector will do
+            mesh.cornerNormals[i] = Vec3f(0, 0, 1);
+            continue;
+        }
+        const Vec3f own = face[t] / area;
+        Vec3f sum(0.f);
+        const uint32_t v = mesh.indices[i];
+        for (uint32_t k = start[v]; k < start[v + 1]; ++k) {
+            const Vec3f& f = face[around[k]];
+            const float len = length(f);
+            if (len > 0 && dot(f, own) >= cosCrease * len) sum += f;
+        }
+        mesh.cornerNormals[i] = normalize(sum);  // includes the own face, so never zero
+    }
 }
 
 void appendBox(TriangleMesh& mesh, const Vec3f& lo, const Vec3f& hi, uint32_t material) {

@@ -49,6 +49,9 @@ struct TriangleMesh {
     std::vector<uint32_t> indices;      // 3 per triangle
     std::vector<uint32_t> materialIds;  // 1 per triangle
     std::vector<uint32_t> shapeIds;     // 1 per triangle: the OBJ group / shape (surfaces the filters keep apart)
+    /// Shading normals, 3 per triangle (one per corner, unit length), or empty for flat shading
+    /// (quads, boxes). OBJ meshes always have them: the file's `vn`, else smoothed face normals.
+    std::vector<Vec3f> cornerNormals;
     Vec3f velocity{0.f};
     size_t triangleCount() const { return indices.size() / 3; }
 };
@@ -86,6 +89,11 @@ struct SceneDesc {
 /// Appends the two triangles of a parallelogram (corner, corner+e1, corner+e1+e2, corner+e2),
 /// wound so that their normal is cross(e1, e2).
 void appendQuad(TriangleMesh& mesh, const Vec3f& corner, const Vec3f& e1, const Vec3f& e2, uint32_t material);
+/// Fills the corner normals of `mesh` that are zero with the area-weighted mean of the face
+/// normals around that corner's vertex, taking only faces within `creaseDegrees` of the
+/// corner's own face, so that a scanned surface shades smoothly and a box keeps its edges.
+/// Allocates cornerNormals (zeros) first if it is empty.
+void smoothCornerNormals(TriangleMesh& mesh, float creaseDegrees);
 /// Appends the 12 outward-facing triangles of an axis-aligned box.
 void appendBox(TriangleMesh& mesh, const Vec3f& lo, const Vec3f& hi, uint32_t material);
 

@@ -24,6 +24,9 @@ using io::JsonNode;
 namespace {
 
 constexpr float kDegToRad = kPi / 180.f;
+/// Crease angle for smoothing the normals of OBJ meshes without `vn`: a box's 90-degree edges
+/// stay sharp, a scan's facets blend.
+constexpr float kCreaseDegrees = 60.f;
 
 Vec3f readScale(JsonNode node) {
     if (node.isArray()) {
@@ -53,6 +56,12 @@ struct Transform {
         Vec3f q = p * scale;
         if (radians != 0) q = rotate(q, axis, radians);
         return q + translate;
+    }
+    /// Normals transform by the inverse transpose: 1/scale, then the rotation.
+    Vec3f applyNormal(const Vec3f& n) const {
+        Vec3f q = n / scale;
+        if (radians != 0) q = rotate(q, axis, radians);
+        return normalize(q);
     }
 };
 
@@ -221,6 +230,7 @@ private:
         std::vector<ParallelogramLight> promoted;
         loadObj(p.string(), fileNode.where(), overrideMaterial, m_desc.materials, mesh, promoted);
         for (auto& v : mesh.positions) v = xf.apply(v);
+        for (auto& n : mesh.cornerNormals) n = xf.applyNormal(n);
         for (auto& l : promoted) {
             Vec3f c0 = xf.apply(l.corner);
             l.edge1 = xf.apply(l.corner + l.edge1) - c0;
@@ -290,7 +300,7 @@ void loadObj(const std::string& path, const std::string& where, int overrideMate
         }
     }
 
-    size_t vertexCount = attrib.vertices.size() / 3;
+    size_t vertexCount = attrib.vertices.size() / 3, normalCount = attrib.normals.size() / 3;
     mesh.positions.reserve(mesh.positions.size() + vertexCount);
     uint32_t base = uint32_t(mesh.positions.size());
     for (size_t i = 0; i < vertexCount; ++i)
@@ -314,11 +324,20 @@ void loadObj(const std::string& path, const std::string& where, int overrideMate
                                        "' has faces without a material (give the object a \"material\")");
             }
             std::vector<uint32_t> idx(n);
+            std::vector<Vec3f> vn(n, Vec3f(0.f));  // the file's normals; zero: to be smoothed
             for (int k = 0; k < n; ++k) {
                 int vi = shape.mesh.indices[offset + k].vertex_index;
                 if (vi < 0 || size_t(vi) >= vertexCount)
                     throw Error(where, "'" + path + "': face refers to a missing vertex");
                 idx[k] = base + uint32_t(vi);
+                int ni = shape.mesh.indices[offset + k].normal_index;
+                if (ni >= 0) {
+                    if (size_t(ni) >= normalCount)
+                        throw Error(where, "'" + path + "': face refers to a missing normal (vn " + std::to_string(ni + 1) + ")");
+                    Vec3f nrm(attrib.normals[3 * ni], attrib.normals[3 * ni + 1], attrib.normals[3 * ni + 2]);
+                    if (!isFinite(nrm)) throw Error(where, "'" + path + "' has a non-finite normal (vn " + std::to_string(ni + 1) + ")");
+                    if (length(nrm) > 0) vn[k] = normalize(nrm);  // a zero vn is smoothed like a missing one
+                }
             }
             offset += n;
             if (n < 3) continue;
@@ -333,12 +352,18 @@ void loadObj(const std::string& path, const std::string& where, int overrideMate
             }
             for (int k = 1; k + 1 < n; ++k) {  // fan triangulation (OBJ faces are convex)
                 mesh.indices.insert(mesh.indices.end(), {idx[0], idx[k], idx[k + 1]});
+                mesh.cornerNormals.insert(mesh.cornerNormals.end(), {vn[0], vn[k], vn[k + 1]});
                 mesh.materialIds.push_back(matId);
                 mesh.shapeIds.push_back(uint32_t(shapeIndex));
             }
         }
     }
     if (mesh.indices.empty()) throw Error(where, "'" + path + "' contains no triangles");
+    // Corners without a `vn` (a scanned mesh has none) shade smoothly across edges under
+    // kCreaseDegrees: per-triangle normals of a fine scan differ by tens of degrees between
+    // neighbours, which would split every pixel's samples into several surfaces (pixel_stats.h)
+    // and shade the tessellation instead of the surface.
+    smoothCornerNormals(mesh, kCreaseDegrees);
 }
 
 SceneDesc parseScene(const std::string& jsonText, const std::string& file, const std::string& baseDir) {
