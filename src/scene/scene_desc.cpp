@@ -1,5 +1,6 @@
 #include "scene/scene_desc.h"
 
+#include <algorithm>
 #include <cmath>
 
 namespace wedge::scene {
@@ -24,6 +25,9 @@ void appendQuad(TriangleMesh& mesh, const Vec3f& corner, const Vec3f& e1, const 
 void smoothCornerNormals(TriangleMesh& mesh, float creaseDegrees) {
     const size_t triangles = mesh.triangleCount();
     if (mesh.cornerNormals.empty()) mesh.cornerNormals.assign(3 * triangles, Vec3f(0.f));
+    // A mesh whose file gives every corner a normal (sponza, conference) needs no adjacency.
+    if (std::none_of(mesh.cornerNormals.begin(), mesh.cornerNormals.end(), [](const Vec3f& n) { return n == Vec3f(0.f); }))
+        return;
     // Area-weighted face normals (the cross product's length is twice the area).
     std::vector<Vec3f> face(triangles);
     for (size_t t = 0; t < triangles; ++t) {

@@ -308,6 +308,8 @@ void loadObj(const std::string& path, const std::string& where, int overrideMate
     for (auto& v : mesh.positions)
         if (!isFinite(v)) throw Error(where, "'" + path + "' has a non-finite vertex coordinate");
 
+    std::vector<uint32_t> idx;  // one face's vertices and normals, reused across faces
+    std::vector<Vec3f> vn;      // the file's normals; zero: to be smoothed
     for (size_t shapeIndex = 0; shapeIndex < shapes.size(); ++shapeIndex) {
         const auto& shape = shapes[shapeIndex];
         size_t offset = 0;
@@ -323,8 +325,8 @@ void loadObj(const std::string& path, const std::string& where, int overrideMate
                 throw Error(where, "'" + path + "': shape '" + shape.name +
                                        "' has faces without a material (give the object a \"material\")");
             }
-            std::vector<uint32_t> idx(n);
-            std::vector<Vec3f> vn(n, Vec3f(0.f));  // the file's normals; zero: to be smoothed
+            idx.assign(n, 0);
+            vn.assign(n, Vec3f(0.f));
             for (int k = 0; k < n; ++k) {
                 int vi = shape.mesh.indices[offset + k].vertex_index;
                 if (vi < 0 || size_t(vi) >= vertexCount)
