@@ -104,6 +104,17 @@ TEST(ExperimentCommand, WritesRowsAndASelfContainedReport) {
     EXPECT_TRUE(seen.count("mc/base") && seen.count("atrous/base"));
     EXPECT_TRUE(seen.count("mc/equal_quality") && seen.count("mc/equal_time"));
     EXPECT_FALSE(seen.count("atrous/equal_quality"));
+    // The reference's own noise (from its two halves) is part of every relMSE: positive, below
+    // the 2-spp mc's error (the reference has 16), and the net relMSE is what is left.
+    for (const auto& r : rows) {
+        ASSERT_TRUE(r.contains("reference_noise_relmse") && r.contains("relmse_net")) << r.dump();
+        const double noise = r["reference_noise_relmse"].get<double>(), relmse = r["relmse"].get<double>();
+        EXPECT_GT(noise, 0.0);
+        EXPECT_NEAR(r["relmse_net"].get<double>(), relmse - noise, 1e-12);
+        if (r["method"] == "mc" && r["setting"] == "base") {
+            EXPECT_LT(noise, 0.5 * relmse);
+        }
+    }
     for (const auto& r : rows) {
         if (r["method"] == "atrous") {
             EXPECT_GT(r["seconds"]["filter"].get<double>(), 0.0);

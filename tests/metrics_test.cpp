@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <fstream>
+#include <random>
 #include <nlohmann/json.hpp>
 
 #include "core/error.h"
@@ -54,6 +55,37 @@ TEST(Metrics, RelMseOfAConstantOffset) {
     double mean = 0;
     for (size_t i = 0; i < map.size(); ++i) mean += map[i];
     EXPECT_NEAR(mean / map.size(), relMse(test, ref), 1e-7);
+}
+
+TEST(Metrics, ReferenceNoiseIsTheShareOfTheReferencesOwnError) {
+    // A truth T, a reference r made of two independent halves (3 and 5 samples of per-sample
+    // std 0.06), and a test image x with its own independent error. The estimate from the halves
+    // must be what the reference adds to relMSE(x, r) on top of relMSE(x, T) (statistical bound:
+    // 196K terms, a few percent).
+    const int W = 256, H = 256, nA = 3, nB = 5;
+    std::mt19937 rng(7);
+    auto gauss = [&] {  // Box-Muller from the engine's raw output (portable)
+        double u1 = (double(rng()) + 1.0) / 4294967297.0, u2 = double(rng()) / 4294967296.0;
+        return std::sqrt(-2.0 * std::log(u1)) * std::cos(6.283185307179586 * u2);
+    };
+    Image3f truth = pattern(W, H), a(W, H), b(W, H), x(W, H);
+    for (size_t i = 0; i < truth.size(); ++i)
+        for (int c = 0; c < 3; ++c) {
+            float t = 0.3f + truth[i][c];
+            truth[i][c] = t;
+            a[i][c] = t + float(0.06 * gauss() / std::sqrt(double(nA)));
+            b[i][c] = t + float(0.06 * gauss() / std::sqrt(double(nB)));
+            x[i][c] = t + float(0.03 * gauss());
+        }
+    Image3f r = combineHalves(a, nA, b, nB);
+    EXPECT_NEAR(r[5].x, (3 * a[5].x + 5 * b[5].x) / 8, 1e-6);
+    const double noise = referenceNoise(a, nA, b, nB);
+    EXPECT_NEAR(noise, relMse(r, truth), 0.03 * relMse(r, truth)) << "the reference's own relMSE";
+    const double own = relMse(x, truth), measured = relMse(x, r);
+    EXPECT_GT(measured - own, 0.5 * noise) << "the reference's noise does inflate the measurement";
+    EXPECT_NEAR(measured - noise, own, 0.03 * own);
+    // Identical halves: no noise.
+    EXPECT_EQ(referenceNoise(a, 2, a, 2), 0.0);
 }
 
 TEST(Metrics, SmapeOfKnownPairs) {

@@ -89,6 +89,25 @@ double relMse(const Image3f& test, const Image3f& reference, float eps) {
     return sum / (3.0 * double(test.size()));
 }
 
+Image3f combineHalves(const Image3f& halfA, int nA, const Image3f& halfB, int nB) {
+    Image3f r(halfA.width(), halfA.height());
+    const float wA = float(nA) / float(nA + nB), wB = float(nB) / float(nA + nB);
+    for (size_t i = 0; i < r.size(); ++i) r[i] = halfA[i] * wA + halfB[i] * wB;
+    return r;
+}
+
+double referenceNoise(const Image3f& halfA, int nA, const Image3f& halfB, int nB, float eps) {
+    const Image3f r = combineHalves(halfA, nA, halfB, nB);
+    const double n = double(nA + nB), k = double(nA) * double(nB) / (n * n);
+    double sum = 0;
+    for (size_t i = 0; i < r.size(); ++i)
+        for (int c = 0; c < 3; ++c) {
+            double d = double(halfA[i][c]) - double(halfB[i][c]), v = r[i][c];
+            sum += k * d * d / (v * v + eps);
+        }
+    return r.size() ? sum / (3.0 * double(r.size())) : 0.0;
+}
+
 double smape(const Image3f& test, const Image3f& reference, float eps) {
     double sum = 0;
     for (size_t i = 0; i < test.size(); ++i)

@@ -40,6 +40,16 @@ Image1f relativeErrorMap(const Image3f& test, const Image3f& reference, float ep
 /// log10 of an error map, floored at 10^lo (for heat maps over [lo, hi] decades).
 Image1f log10Map(const Image1f& values, float lo);
 
+/// The reference's own share of a relMSE measured against it. A Monte Carlo reference r made of
+/// two independent halves A (nA samples) and B (nB samples), r = (nA A + nB B) / (nA + nB), has
+/// per-pixel variance Var r = E[(A - B)^2] nA nB / (nA + nB)^2; since a method's error is
+/// independent of the reference's, E[relMSE(x, r)] = relMSE(x, truth) + mean(Var r / (r^2 + eps)).
+/// Returns that mean, estimated from the halves' squared differences (to first order in the
+/// reference's relative variance, which also enters the denominators).
+double referenceNoise(const Image3f& halfA, int nA, const Image3f& halfB, int nB, float eps = kRelMseEpsilon);
+/// The reference both halves make, (nA A + nB B) / (nA + nB).
+Image3f combineHalves(const Image3f& halfA, int nA, const Image3f& halfB, int nB);
+
 struct Metrics {
     double relMse = 0, smape = 0, psnr = 0, ssim = 0;
 };

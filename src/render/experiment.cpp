@@ -170,24 +170,32 @@ void Experiment::loadOrRenderReference() {
             m_reference = io::readColor(exr.string());
             nlohmann::json j = nlohmann::json::parse(readFile(meta.string()));
             m_result.referenceSeconds = j.at("seconds").get<double>();
+            m_result.referenceNoise = j.at("noise_relmse").get<double>();  // older entries lack it: render again
             if (m_reference.sameSize(m_result.width, m_result.height)) {
                 m_result.referenceCached = true;
                 say("reference from cache " + exr.string());
                 return;
             }
         } catch (const std::exception&) {
-            // A damaged cache entry is rendered again and overwritten.
+            // A damaged or older cache entry is rendered again and overwritten.
         }
     }
-    say("rendering the reference: mc, " + std::to_string(m_result.referenceSpp) + " spp");
+    // Two independent halves (the second with its own seed): their difference measures the
+    // reference's own noise.
+    const int nA = m_result.referenceSpp / 2, nB = m_result.referenceSpp - nA;
+    say("rendering the reference: mc, " + std::to_string(m_result.referenceSpp) + " spp in two independent halves");
     RenderOptions o = m_options.base;
     o.method = "mc";
-    o.spp = m_result.referenceSpp;
-    o.seed = m_result.referenceSeed;
     o.quiet = m_options.quiet;
-    RenderResult r = render(m_scene, o);
-    m_reference = r.color;
-    m_result.referenceSeconds = r.seconds.get("total");
+    o.spp = nA;
+    o.seed = m_result.referenceSeed;
+    RenderResult a = render(m_scene, o);
+    o.spp = nB;
+    o.seed = hashCombine(m_result.referenceSeed, 0x68616c66U);
+    RenderResult b = render(m_scene, o);
+    m_reference = metrics::combineHalves(a.color, nA, b.color, nB);
+    m_result.referenceNoise = metrics::referenceNoise(a.color, nA, b.color, nB);
+    m_result.referenceSeconds = a.seconds.get("total") + b.seconds.get("total");
     fs::create_directories(m_options.cacheDir);
     io::writeColor(exr.string(), m_reference);
     nlohmann::json j;
@@ -196,6 +204,7 @@ void Experiment::loadOrRenderReference() {
     j["spp"] = m_result.referenceSpp;
     j["seed"] = m_result.referenceSeed;
     j["seconds"] = m_result.referenceSeconds;
+    j["noise_relmse"] = m_result.referenceNoise;
     writeTextFile(meta.string(), j.dump(2) + "\n");
 }
 
@@ -368,6 +377,8 @@ ExperimentResult Experiment::run() {
     for (auto& row : m_result.rows) {
         double err = row.probe.metrics.relMse * row.probe.seconds.get("total");
         row.efficiency = err > 0 ? 1.0 / err : 0.0;
+        double net = (row.probe.metrics.relMse - m_result.referenceNoise) * row.probe.seconds.get("total");
+        row.netEfficiency = net > 0 ? 1.0 / net : 0.0;
     }
 
     writeImages();
@@ -455,6 +466,9 @@ void Experiment::writeResultsJson() const {
         j["psnr"] = finiteOrNull(row.probe.metrics.psnr);
         j["ssim"] = row.probe.metrics.ssim;
         j["efficiency"] = row.efficiency;
+        j["reference_noise_relmse"] = m_result.referenceNoise;
+        j["relmse_net"] = row.probe.metrics.relMse - m_result.referenceNoise;
+        j["efficiency_net"] = row.netEfficiency;
         j["overhead"] = overhead(row.probe.seconds);
         j["scene"] = m_result.scene;
         j["resolution"] = {m_result.width, m_result.height};
@@ -490,10 +504,10 @@ std::string Experiment::markdownTable() const {
     const ExperimentRow* mcBase = find("mc", "base");
     if (!m_options.commandLine.empty()) os << "`" << m_options.commandLine << "`\n\n";
     os << "| " << m_result.scene << " " << m_result.width << "x" << m_result.height
-       << " | spp | sampling | prefilter | filter | overhead | total | relMSE | PSNR | SSIM | efficiency |";
+       << " | spp | sampling | prefilter | filter | overhead | total | relMSE | net relMSE | PSNR | SSIM | efficiency | net efficiency |";
     if (m_options.equalQuality) os << " EQ spp | EQ total | " << m_result.anchor << " speedup |";
     if (m_options.equalTime) os << " ET spp | ET relMSE |";
-    os << "\n|---|---|---|---|---|---|---|---|---|---|---|";
+    os << "\n|---|---|---|---|---|---|---|---|---|---|---|---|---|";
     if (m_options.equalQuality) os << "---|---|---|";
     if (m_options.equalTime) os << "---|---|";
     os << "\n";
@@ -503,10 +517,14 @@ std::string Experiment::markdownTable() const {
         os << "| " << r.method << " | " << format("%.1f", p.sppAverage) << " | " << seconds(p.seconds.get("sampling"))
            << " | " << seconds(p.seconds.get("prefilter")) << " | " << seconds(p.seconds.get("filter")) << " | "
            << format("%.1f%%", 100 * overhead(p.seconds)) << " | " << seconds(p.seconds.get("total")) << " | "
-           << format("%.4g", p.metrics.relMse) << " | " << format("%.2f", p.metrics.psnr) << " | "
-           << format("%.4f", p.metrics.ssim) << " | ";
+           << format("%.4g", p.metrics.relMse) << " | " << format("%.4g", p.metrics.relMse - m_result.referenceNoise)
+           << " | " << format("%.2f", p.metrics.psnr) << " | " << format("%.4f", p.metrics.ssim) << " | ";
         if (mcBase && mcBase->efficiency > 0) os << format("%.2fx mc", r.efficiency / mcBase->efficiency);
         else os << format("%.4g", r.efficiency);
+        os << " | ";
+        if (r.netEfficiency <= 0) os << "-";
+        else if (mcBase && mcBase->netEfficiency > 0) os << format("%.2fx mc", r.netEfficiency / mcBase->netEfficiency);
+        else os << format("%.4g", r.netEfficiency);
         os << " |";
         if (m_options.equalQuality) {
             const ExperimentRow* eq = find(r.method, "equal_quality");
@@ -525,10 +543,13 @@ std::string Experiment::markdownTable() const {
         }
         os << "\n";
     }
-    os << "\nReference: mc " << m_result.referenceSpp << " spp. " << ThreadLimit::current() << " threads"
+    os << "\nReference: mc " << m_result.referenceSpp << " spp in two independent halves; its own noise, estimated from "
+       << "them, is relMSE " << format("%.4g", m_result.referenceNoise)
+       << " (part of every relMSE here; net relMSE = relMSE minus it, what a noise-free reference would measure). "
+       << ThreadLimit::current() << " threads"
        << (m_options.repeat > 1 ? ", times the fastest of " + std::to_string(m_options.repeat) + " renders" : "")
        << ". relMSE with eps 0.01, no 0.5 factor; PSNR/SSIM on tone-mapped images. "
-       << "Efficiency = 1/(relMSE x total seconds)";
+       << "Efficiency = 1/(relMSE x total seconds), net efficiency the same with the net relMSE";
     if (mcBase) os << ", relative to mc at the same spp";
     os << ".";
     if (m_options.equalQuality)
@@ -573,7 +594,7 @@ void Experiment::writeHtml() const {
       << ".legend{display:inline-block;width:200px;height:12px;vertical-align:middle;background:linear-gradient(90deg,"
       << kHeatGradient << ")}\ncode{font-size:12px}\n</style></head><body>\n";
     h << "<h1>" << htmlEscape(m_result.scene) << " &mdash; " << m_result.width << "&times;" << m_result.height << ", "
-      << m_options.spp << " spp</h1>\n<p>Reference: mc " << m_result.referenceSpp << " spp (seed "
+      << m_options.spp << " spp</h1>\n<p>Reference: mc " << m_result.referenceSpp << " spp in two independent halves (seed "
       << m_result.referenceSeed << "), " << seconds(m_result.referenceSeconds)
       << (m_result.referenceCached ? " (cached)" : "") << ". Methods use seed " << m_result.seed << ". Anchor for equal "
       << "quality and equal time: <b>" << htmlEscape(m_result.anchor) << "</b>. Threads: " << ThreadLimit::current()
@@ -624,15 +645,19 @@ void Experiment::writeHtml() const {
           << m_cap << " spp. Speedup = EQ total / " << htmlEscape(m_result.anchor) << " total.</p>\n";
 
     h << "<h2>Quality</h2>\n<table><tr><th>method</th><th>setting</th><th>spp</th><th>total</th><th>relMSE</th>"
-         "<th>SMAPE</th><th>PSNR (dB)</th><th>SSIM</th><th>efficiency 1/(relMSE&middot;s)</th></tr>\n";
+         "<th>net relMSE</th><th>SMAPE</th><th>PSNR (dB)</th><th>SSIM</th><th>efficiency 1/(relMSE&middot;s)</th>"
+         "<th>net efficiency</th></tr>\n";
     for (const auto& r : m_result.rows) {
         const auto& m = r.probe.metrics;
         std::string mark = r.setting != "base" && !r.reached ? " (bound)" : "";
         h << "<tr>" << td(htmlEscape(r.method)) << td(settingLabel(r.setting) + mark) << td(format("%.1f", r.probe.sppAverage))
-          << td(seconds(r.probe.seconds.get("total"))) << td(format("%.4g", m.relMse)) << td(format("%.4f", m.smape))
-          << td(format("%.2f", m.psnr)) << td(format("%.4f", m.ssim)) << td(format("%.4g", r.efficiency)) << "</tr>\n";
+          << td(seconds(r.probe.seconds.get("total"))) << td(format("%.4g", m.relMse))
+          << td(format("%.4g", m.relMse - m_result.referenceNoise)) << td(format("%.4f", m.smape))
+          << td(format("%.2f", m.psnr)) << td(format("%.4f", m.ssim)) << td(format("%.4g", r.efficiency))
+          << td(r.netEfficiency > 0 ? format("%.4g", r.netEfficiency) : "-") << "</tr>\n";
     }
-    h << "</table>\n<p>relMSE = mean (x&minus;r)&sup2;/(r&sup2;+0.01), no 0.5 factor, linear radiance. PSNR and SSIM "
+    h << "</table>\n<p>relMSE = mean (x&minus;r)&sup2;/(r&sup2;+0.01), no 0.5 factor, linear radiance; net relMSE = "
+         "relMSE &minus; the reference's own noise. PSNR and SSIM "
          "(11&times;11 Gaussian, &sigma; 1.5) on tone-mapped images (clamp, sRGB).</p>\n";
 
     // Images side by side, with insets and heat maps.

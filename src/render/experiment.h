@@ -12,7 +12,11 @@
 //
 // The reference is plain MC at --reference-spp with an independent seed (a hash of the seed), so
 // the methods' errors are not correlated with it; it is cached under the cache directory, keyed
-// by scene name, a hash of the scene file, resolution, spp and seed.
+// by scene name, a hash of the scene file, resolution, spp and seed. It is rendered as two
+// independent halves, whose difference estimates its own noise (metrics::referenceNoise): every
+// relMSE measured against it carries that much on top of the method's error against the truth,
+// which pulls all ratios towards 1. Rows report the net relMSE (relMSE - noise) and the net
+// efficiency beside the measured ones.
 #pragma once
 
 #include <algorithm>
@@ -60,7 +64,8 @@ struct ExperimentRow {
     std::string method;
     std::string setting;  // "base", "equal_quality" or "equal_time"
     ExperimentProbe probe;
-    double efficiency = 0;  // 1 / (relMSE * total seconds)
+    double efficiency = 0;     // 1 / (relMSE * total seconds)
+    double netEfficiency = 0;  // 1 / ((relMSE - reference noise) * total seconds); 0 if not positive
     // Searches: the target (relMSE or seconds), whether it was reached within the cap, and every
     // render the search made, in order.
     double target = 0;
@@ -75,6 +80,7 @@ struct ExperimentResult {
     uint32_t seed = 0, referenceSeed = 0;
     int referenceSpp = 0;
     double referenceSeconds = 0;
+    double referenceNoise = 0;  // the reference's own relMSE against the truth (estimated)
     bool referenceCached = false;
     std::string anchor;
     std::vector<std::string> skipped;  // requested methods that are not available yet
