@@ -15,6 +15,7 @@
 #include "filter/defocus.h"
 #include "filter/maaf.h"
 #include "filter/maaf_components.h"
+#include "filter/wedge_field.h"
 
 using namespace wedge;
 using namespace wedge::filter;
@@ -111,6 +112,53 @@ TEST(AafFilter, SameResultOnOneAndTwoThreads) {
         b = aafFilter(signal, omega, pl.fb, pl.frames, AafOptions());
     }
     EXPECT_EQ(0, std::memcmp(a.data(), b.data(), a.size() * sizeof(Vec3f)));
+}
+
+TEST(WedgeField, PrefilterKeepsWellSampledSlopesAndWidensTheRest) {
+    // A 9x9 plane: pixel (4, 4) saw an occluder with 30% or 60% of its shadow rays, slopes
+    // [1, 2]; a neighbour two pixels away saw [0.5, 4]; one beyond the 5x5 window saw [0.1, 9];
+    // pixel (1, 1) saw none. The other object's pixel (4, 3) saw [0.01, 50] and must never count.
+    Plane pl(9, 9);
+    FrameBuffers& fb = pl.fb;
+    for (size_t i = 0; i < fb.sMin.size(); ++i) {
+        fb.sMin[i] = kInf;
+        fb.sMax[i] = 0;
+        fb.zMin[i] = fb.zMax[i] = kInf;
+        fb.occluded[i] = 0;
+    }
+    auto set = [&](int x, int y, float lo, float hi, float occluded) {
+        fb.sMin(x, y) = lo;
+        fb.sMax(x, y) = hi;
+        fb.occluded(x, y) = occluded;
+    };
+    set(6, 4, 0.5f, 4.f, 0.2f);
+    set(4, 7, 0.1f, 9.f, 0.2f);
+    set(4, 3, 0.01f, 50.f, 1.f);
+    fb.object(4, 3) = 1;
+    for (float occluded : {0.3f, 0.6f}) {
+        set(4, 4, 1.f, 2.f, occluded);
+        WedgeOptions maxMin;  // 5x5, keep own slopes from half the rays occluded
+        maxMin.ownShadowOccluded = 0.5f;
+        WedgeField a = prefilterWedges(fb, maxMin);
+        const bool own = occluded >= 0.5f;
+        EXPECT_FLOAT_EQ(a.s2(4, 4), own ? 1.f : 0.5f) << occluded;
+        EXPECT_FLOAT_EQ(a.s1(4, 4), own ? 2.f : 4.f) << occluded;
+        WedgeOptions never = maxMin;
+        never.ownShadowOccluded = 2.f;
+        WedgeField b = prefilterWedges(fb, never);
+        EXPECT_FLOAT_EQ(b.s2(4, 4), 0.5f);
+        EXPECT_FLOAT_EQ(b.s1(4, 4), 4.f);
+        WedgeOptions fill;  // AAF: own slopes whenever there are any
+        fill.fillOnly = true;
+        WedgeField c = prefilterWedges(fb, fill);
+        EXPECT_FLOAT_EQ(c.s2(4, 4), 1.f);
+        EXPECT_FLOAT_EQ(c.s1(4, 4), 2.f);
+        // A pixel with no slopes of its own takes its window's extremes on its own object:
+        // (5, 5) sees (4, 4), (6, 4) and (4, 7), not (4, 3); (1, 1) sees none.
+        EXPECT_FLOAT_EQ(a.s2(5, 5), 0.1f);
+        EXPECT_FLOAT_EQ(a.s1(5, 5), 9.f);
+        EXPECT_GE(a.s2(1, 1), kInf);
+    }
 }
 
 TEST(MaafComponents, OneComponentIsTheAxisAlignedFilterOfEq2) {

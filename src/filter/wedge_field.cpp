@@ -12,6 +12,7 @@ WedgeField prefilterWedges(const FrameBuffers& fb, const WedgeOptions& o) {
             size_t p = size_t(y) * W + x;
             float s1 = 0, s2 = kInf, zMin = kInf, zMax = 0, suMin = kInf, suMax = -kInf;
             bool ownShadow = fb.sMin[p] < kInf, ownBounce = fb.zMin[p] < kInf;
+            const bool keepShadow = ownShadow && (o.fillOnly || fb.occluded[p] >= o.ownShadowOccluded);
             for (int dy = -o.radius; dy <= o.radius; ++dy) {
                 int yy = y + dy;
                 if (yy < 0 || yy >= H) continue;
@@ -21,7 +22,7 @@ WedgeField prefilterWedges(const FrameBuffers& fb, const WedgeOptions& o) {
                     size_t q = size_t(yy) * W + xx;
                     if (q != p && !sameSurface(fb, p, q, o.normalCos)) continue;
                     if (fb.object[q] < 0) continue;
-                    if (!(o.fillOnly && ownShadow) && fb.sMin[q] < kInf) {
+                    if (!keepShadow && fb.sMin[q] < kInf) {
                         s1 = std::max(s1, fb.sMax[q]);
                         s2 = std::min(s2, fb.sMin[q]);
                     }
@@ -33,7 +34,7 @@ WedgeField prefilterWedges(const FrameBuffers& fb, const WedgeOptions& o) {
                     suMax = std::max(suMax, fb.suMax[q]);
                 }
             }
-            if (o.fillOnly && ownShadow) { s1 = fb.sMax[p]; s2 = fb.sMin[p]; }
+            if (keepShadow) { s1 = fb.sMax[p]; s2 = fb.sMin[p]; }
             if (o.fillOnly && ownBounce) { zMin = fb.zMin[p]; zMax = fb.zMax[p]; }
             wf.s1[p] = s1;
             wf.s2[p] = s2;

@@ -23,6 +23,10 @@ struct WedgeField {
 struct WedgeOptions {
     int radius = 2;          // window half-size for the slope prefilter
     bool fillOnly = false;   // true: keep a pixel's own slopes when it has them (AAF), only fill empty ones
+    // Otherwise (max / min over the window, MAAF) a pixel keeps its own shadow slopes when at
+    // least this fraction of its shadow rays hit an occluder: many occluder spans give a
+    // trustworthy slope range, a few (a penumbra's edge, a contact shadow) do not. > 1: never.
+    float ownShadowOccluded = 2.f;
     int fillRadius = 0;      // > radius: pixels still without a wedge take it from this wider window
     int focalRadius = 10;    // window half-size of the focal-plane (sign change) detection
     float normalCos = 0.9396926f;  // cos 20 degrees
