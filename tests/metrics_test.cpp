@@ -88,6 +88,45 @@ TEST(Metrics, ReferenceNoiseIsTheShareOfTheReferencesOwnError) {
     EXPECT_EQ(referenceNoise(a, 2, a, 2), 0.0);
 }
 
+TEST(Metrics, RegionErrorsSplitTheErrorByPixelClass) {
+    // 12x8: objects 0 (x < 6) and 1 (x >= 6), pixel (0, 0) background, (2, 6) mixed, the right
+    // object's rows y >= 4 defocused. Relative squared error 1 (eps 0: test 2 against 1) at
+    // (0, 0) background, (2, 6) mixed, (5, 3) edge (next to object 1), (1, 1) edge (next to the
+    // background pixel), (9, 6) defocused and (3, 3) interior.
+    const int W = 12, H = 8;
+    Image3f ref = constant(W, H, 1.f), test = ref;
+    Image1f object(W, H), coverage(W, H), defocus(W, H);
+    for (int y = 0; y < H; ++y)
+        for (int x = 0; x < W; ++x) {
+            object(x, y) = x < 6 ? 0.f : 1.f;
+            coverage(x, y) = 1.f;
+            defocus(x, y) = x >= 6 && y >= 4 ? 3.f : 0.f;
+        }
+    object(0, 0) = -1;
+    coverage(2, 6) = 0.5f;
+    for (auto [x, y] : {std::pair{0, 0}, {2, 6}, {5, 3}, {9, 6}, {1, 1}, {3, 3}}) test(x, y) = Vec3f(2.f);
+    auto r = regionErrors(test, ref, object, coverage, defocus, 2, 0.f);
+    ASSERT_EQ(r.size(), 5u);
+    double pixels = 0, share = 0;
+    for (const auto& c : r) {
+        pixels += c.pixels;
+        share += c.share;
+    }
+    EXPECT_NEAR(pixels, 1.0, 1e-12);
+    EXPECT_NEAR(share, 1.0, 1e-12);
+    EXPECT_EQ(r[0].name, "background");
+    EXPECT_NEAR(r[0].pixels, 1.0 / 96, 1e-12);
+    EXPECT_NEAR(r[0].share, 1.0 / 6, 1e-12);
+    EXPECT_NEAR(r[0].relMse, 1.0, 1e-12);
+    EXPECT_NEAR(r[1].share, 1.0 / 6, 1e-12);  // mixed: (2, 6)
+    EXPECT_NEAR(r[2].share, 2.0 / 6, 1e-12);  // edge: (5, 3), (1, 1)
+    EXPECT_NEAR(r[3].share, 1.0 / 6, 1e-12);  // defocused: (9, 6)
+    EXPECT_NEAR(r[4].share, 1.0 / 6, 1e-12);  // interior: (3, 3)
+    // Edge pixels: around the background and the mixed pixel, and columns 4..7 along the border.
+    EXPECT_GT(r[2].pixels, 0.3);
+    EXPECT_LT(r[4].pixels + r[3].pixels, 0.7);
+}
+
 TEST(Metrics, SmapeOfKnownPairs) {
     EXPECT_NEAR(smape(constant(4, 4, 1.f), constant(4, 4, 0.f)), 1.0 / 1.01, 1e-6);
     EXPECT_NEAR(smape(constant(4, 4, 3.f), constant(4, 4, 1.f)), 2.0 / 4.01, 1e-6);
@@ -186,6 +225,34 @@ TEST(CompareCommand, PrintsJsonAndWritesAHeatMap) {
     Image3f heat = io::readPng(dir + "/heat.png");
     EXPECT_EQ(heat.width(), 6);
     EXPECT_EQ(heat.height(), 5);
+}
+
+TEST(CompareCommand, RegionsSplitARendersErrorAndNeedItsPlanes) {
+    std::string dir = test::tempDir(), out, err;
+    ASSERT_EQ(test::runWedge("render cornell --method mc --spp 2 --resolution 24x24 --quiet -o " + dir + "/x.exr", &out, &err), 0)
+        << err;
+    ASSERT_EQ(test::runWedge("render cornell --method mc --spp 32 --resolution 24x24 --quiet --seed 9 -o " + dir + "/r.exr",
+                             &out, &err),
+              0)
+        << err;
+    ASSERT_EQ(test::runWedge("compare " + dir + "/x.exr " + dir + "/r.exr --regions --json", &out, &err), 0) << err;
+    auto j = nlohmann::json::parse(out);
+    double share = 0, pixels = 0, weighted = 0;
+    for (const char* name : {"background", "mixed", "edge", "defocused", "interior"}) {
+        ASSERT_TRUE(j["regions"].contains(name)) << name;
+        share += j["regions"][name]["share"].get<double>();
+        pixels += j["regions"][name]["pixels"].get<double>();
+        weighted += j["regions"][name]["pixels"].get<double>() * j["regions"][name]["relmse"].get<double>();
+    }
+    EXPECT_NEAR(share, 1.0, 1e-9);
+    EXPECT_NEAR(pixels, 1.0, 1e-9);
+    EXPECT_NEAR(weighted, j["relmse"].get<double>(), 1e-6 * j["relmse"].get<double>());
+    EXPECT_GT(j["regions"]["mixed"]["pixels"].get<double>(), 0.0) << "the box's edges mix surfaces";
+    // A PFM has no planes to split by.
+    io::writePfm(dir + "/x.pfm", io::readColor(dir + "/x.exr"));
+    EXPECT_EQ(test::runWedge("compare " + dir + "/x.pfm " + dir + "/r.exr --regions", &out, &err), 2);
+    EXPECT_NE(err.find("--regions"), std::string::npos) << err;
+    EXPECT_NE(err.find("x.pfm"), std::string::npos) << err;
 }
 
 TEST(CompareCommand, BadInputExitsWithTwo) {

@@ -1,6 +1,7 @@
-// wedge compare TEST REF [--json] [--heatmap OUT.png]: relMSE, SMAPE, PSNR and SSIM of a
-// rendering against a reference (metrics/metrics.h), and a heat map of the per-pixel relative
-// squared error on a log scale.
+// wedge compare TEST REF [--json] [--heatmap OUT.png] [--regions]: relMSE, SMAPE, PSNR and SSIM
+// of a rendering against a reference (metrics/metrics.h), a heat map of the per-pixel relative
+// squared error on a log scale, and where that error sits (metrics::regionErrors).
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <memory>
@@ -17,8 +18,18 @@ namespace {
 
 struct CompareArgs {
     std::string test, reference, heatmap;
-    bool json = false;
+    bool json = false, regions = false;
 };
+
+/// A plane of a wedge EXR that --regions needs; a clear error when the file has no such plane.
+Image1f plane(const io::ExrImage& exr, const std::string& path, const std::string& name) {
+    auto it = exr.channels.find(name);
+    if (it == exr.channels.end())
+        throw Error(path, "--regions needs the '" + name + "' plane of an EXR written by `wedge render -o x.exr`");
+    Image1f img(exr.width, exr.height);
+    std::copy(it->second.begin(), it->second.end(), img.data());
+    return img;
+}
 
 // Heat maps show log10 relative squared error from 10^-4 (dark) to 10^0 (yellow).
 constexpr float kHeatLo = -4.f, kHeatHi = 0.f;
@@ -30,6 +41,14 @@ void runCompare(const CompareArgs& a) {
         throw Error(a.test, "image size mismatch: " + std::to_string(test.width()) + "x" + std::to_string(test.height()) +
                                 " against " + std::to_string(reference.width()) + "x" +
                                 std::to_string(reference.height()) + " in " + a.reference);
+    std::vector<metrics::RegionError> regions;
+    if (a.regions) {
+        if (io::extension(a.test) != ".exr")
+            throw Error(a.test, "--regions needs an EXR written by `wedge render -o x.exr` (its coverage and object planes)");
+        const io::ExrImage exr = io::readExr(a.test);
+        regions = metrics::regionErrors(test, reference, plane(exr, a.test, "object"), plane(exr, a.test, "coverage"),
+                                        plane(exr, a.test, "slope.defocus"));
+    }
     metrics::Metrics m = metrics::compare(test, reference);
     if (!a.heatmap.empty())
         io::writePngHeat(a.heatmap, metrics::log10Map(metrics::relativeErrorMap(test, reference), kHeatLo), kHeatLo,
@@ -43,12 +62,22 @@ void runCompare(const CompareArgs& a) {
         j["smape"] = m.smape;
         j["psnr"] = std::isfinite(m.psnr) ? nlohmann::json(m.psnr) : nlohmann::json(nullptr);  // null: identical
         j["ssim"] = m.ssim;
+        if (a.regions) {
+            nlohmann::json r = nlohmann::json::object();
+            for (const auto& c : regions) r[c.name] = {{"pixels", c.pixels}, {"share", c.share}, {"relmse", c.relMse}};
+            j["regions"] = r;
+        }
         std::printf("%s\n", j.dump(2).c_str());
     } else {
         std::printf("relMSE %.6g  (eps %.2g, no 0.5 factor)\n", m.relMse, double(metrics::kRelMseEpsilon));
         std::printf("SMAPE  %.6g\n", m.smape);
         std::printf("PSNR   %.3f dB  (tone-mapped)\n", m.psnr);
         std::printf("SSIM   %.5f  (tone-mapped)\n", m.ssim);
+        if (a.regions) {
+            std::printf("%-11s %8s %8s %10s\n", "region", "pixels", "error", "relMSE");
+            for (const auto& c : regions)
+                std::printf("%-11s %7.1f%% %7.1f%% %10.4g\n", c.name.c_str(), 100 * c.pixels, 100 * c.share, c.relMse);
+        }
     }
 }
 
@@ -60,6 +89,9 @@ void registerCompare(CLI::App& app) {
     cmd->add_option("test", args->test, "Image to measure (.exr, .png, .pfm)")->required();
     cmd->add_option("reference", args->reference, "Reference image (.exr, .png, .pfm)")->required();
     cmd->add_flag("--json", args->json, "Print the metrics as JSON");
+    cmd->add_flag("--regions", args->regions,
+                  "Split relMSE over pixel classes of TEST's own planes (an EXR from wedge render): background, "
+                  "mixed surfaces, edge (within 2 px), defocused, interior");
     cmd->add_option("--heatmap", args->heatmap, "Write a heat map of log10 relative squared error (10^-4..1) as PNG");
     cmd->callback([args] { runCompare(*args); });
 }

@@ -108,6 +108,43 @@ double referenceNoise(const Image3f& halfA, int nA, const Image3f& halfB, int nB
     return r.size() ? sum / (3.0 * double(r.size())) : 0.0;
 }
 
+std::vector<RegionError> regionErrors(const Image3f& test, const Image3f& reference, const Image1f& object,
+                                      const Image1f& coverage, const Image1f& defocus, int edgeRadius, float eps) {
+    const int W = test.width(), H = test.height();
+    const Image1f e = relativeErrorMap(test, reference, eps);
+    std::vector<RegionError> r = {{"background"}, {"mixed"}, {"edge"}, {"defocused"}, {"interior"}};
+    auto mixed = [&](size_t i) { return object[i] >= 0 && coverage[i] < 0.999f; };
+    double total = 0;
+    for (int y = 0; y < H; ++y)
+        for (int x = 0; x < W; ++x) {
+            const size_t i = size_t(y) * W + x;
+            int k;
+            if (object[i] < 0) k = 0;
+            else if (mixed(i)) k = 1;
+            else {
+                bool near = false;
+                for (int dy = -edgeRadius; dy <= edgeRadius && !near; ++dy)
+                    for (int dx = -edgeRadius; dx <= edgeRadius && !near; ++dx) {
+                        const int xx = x + dx, yy = y + dy;
+                        if (xx < 0 || yy < 0 || xx >= W || yy >= H) continue;
+                        const size_t q = size_t(yy) * W + xx;
+                        near = mixed(q) || object[q] != object[i];
+                    }
+                k = near ? 2 : defocus[i] > 1.f ? 3 : 4;
+            }
+            r[k].pixels += 1;
+            r[k].share += e[i];
+            total += e[i];
+        }
+    const double n = double(W) * double(H);
+    for (auto& c : r) {
+        c.relMse = c.pixels > 0 ? c.share / c.pixels : 0.0;
+        c.share = total > 0 ? c.share / total : 0.0;
+        c.pixels = n > 0 ? c.pixels / n : 0.0;
+    }
+    return r;
+}
+
 double smape(const Image3f& test, const Image3f& reference, float eps) {
     double sum = 0;
     for (size_t i = 0; i < test.size(); ++i)

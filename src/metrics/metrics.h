@@ -11,6 +11,9 @@
 // smaller than the window) gets a value.
 #pragma once
 
+#include <string>
+#include <vector>
+
 #include "core/image.h"
 
 namespace wedge::metrics {
@@ -49,6 +52,21 @@ Image1f log10Map(const Image1f& values, float lo);
 double referenceNoise(const Image3f& halfA, int nA, const Image3f& halfB, int nB, float eps = kRelMseEpsilon);
 /// The reference both halves make, (nA A + nB B) / (nA + nB).
 Image3f combineHalves(const Image3f& halfA, int nA, const Image3f& halfB, int nB);
+
+/// Where the error sits: relMSE split over pixel classes of the test render's own planes
+/// (`wedge render -o x.exr` writes them): background (object < 0), mixed (coverage < 1: the
+/// samples saw more than one surface, or a surface and the background), edge (within
+/// `edgeRadius` pixels of a mixed pixel or of a pixel on another object), defocused (slope.defocus
+/// above one pixel per lens radius) and interior (the rest).
+struct RegionError {
+    std::string name;
+    double pixels = 0;  // fraction of the image's pixels
+    double share = 0;   // fraction of the summed relative squared error
+    double relMse = 0;  // mean over the class's pixels
+};
+std::vector<RegionError> regionErrors(const Image3f& test, const Image3f& reference, const Image1f& object,
+                                      const Image1f& coverage, const Image1f& defocus, int edgeRadius = 2,
+                                      float eps = kRelMseEpsilon);
 
 struct Metrics {
     double relMse = 0, smape = 0, psnr = 0, ssim = 0;
