@@ -134,6 +134,8 @@ TEST(ExperimentCommand, WritesRowsAndASelfContainedReport) {
     EXPECT_EQ(images, 5 * 3 + 4);
     EXPECT_NE(html.find("Fig. 12"), std::string::npos);
     EXPECT_NE(html.find("speedup"), std::string::npos);
+    EXPECT_NE(html.find("its own noise"), std::string::npos);
+    EXPECT_NE(html.find("net relMSE"), std::string::npos);
     EXPECT_TRUE(fs::is_regular_file(dir + "/table.md"));
 }
 

@@ -596,7 +596,9 @@ void Experiment::writeHtml() const {
     h << "<h1>" << htmlEscape(m_result.scene) << " &mdash; " << m_result.width << "&times;" << m_result.height << ", "
       << m_options.spp << " spp</h1>\n<p>Reference: mc " << m_result.referenceSpp << " spp in two independent halves (seed "
       << m_result.referenceSeed << "), " << seconds(m_result.referenceSeconds)
-      << (m_result.referenceCached ? " (cached)" : "") << ". Methods use seed " << m_result.seed << ". Anchor for equal "
+      << (m_result.referenceCached ? " (cached)" : "") << "; its own noise, estimated from the halves' difference, is "
+      << "relMSE " << format("%.4g", m_result.referenceNoise) << ", part of every relMSE below. Methods use seed "
+      << m_result.seed << ". Anchor for equal "
       << "quality and equal time: <b>" << htmlEscape(m_result.anchor) << "</b>. Threads: " << ThreadLimit::current()
       << (m_options.repeat > 1 ? "; times are the fastest of " + std::to_string(m_options.repeat) + " renders" : "")
       << ".";
