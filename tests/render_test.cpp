@@ -9,6 +9,7 @@
 #include "core/parallel.h"
 #include "render/camera.h"
 #include "render/pixel_stats.h"
+#include "render/methods.h"
 #include "render/renderer.h"
 #include "scene/scene.h"
 #include "scene/scene_loader.h"
@@ -258,4 +259,45 @@ TEST(Render, MixedPixelsAreToppedUpByTheirRelativeVariance) {
     EXPECT_EQ(mixed.mixedTopUp(0.01f, 16), 0u);  // the cap counts every sample
     EXPECT_GT(bright.mixedTopUp(0.05f, 1024), 16u);
     EXPECT_EQ(one.primary(), 0);
+}
+
+TEST(Render, EmitterEdgesAndTheirDefocusRimsAreToppedUp) {
+    // 16x12 pixels of 16 samples on a dark surface; pixel (5, 5) saw an emitter with 4 of them,
+    // (6, 5) with all 16, both with circles of confusion up to 2.5 px. Pixels within
+    // ceil(2.5) + 1 = 4 of either that did not see only the emitter are topped up (their 16
+    // samples miss the few percent of the blurred emitter that reach them); farther ones, pixels
+    // that saw nothing but the emitter and pixels past the target are not.
+    const int W = 16, H = 12;
+    Image<render::PixelStats> stats(W, H);
+    for (int y = 0; y < H; ++y)
+        for (int x = 0; x < W; ++x) {
+            render::PixelStats& s = stats(x, y);
+            s.n = 16;
+            s.suLo = -0.5f;
+            s.suHi = 0.5f;
+        }
+    stats(5, 5).nEmitter = 4;
+    stats(5, 5).suLo = -2.5f;
+    stats(6, 5).nEmitter = 16;
+    stats(6, 5).suLo = -2.5f;
+    stats(3, 3).n = 300;
+    auto extra = render::emitterTopUps(stats, 256);
+    EXPECT_EQ(extra(5, 5), 240u);  // the edge pixel itself
+    EXPECT_EQ(extra(6, 5), 0u);    // every sample saw the emitter
+    EXPECT_EQ(extra(1, 1), 240u);  // 4 px from (5, 5) on both axes
+    EXPECT_EQ(extra(10, 9), 240u); // 4 px from (6, 5)
+    EXPECT_EQ(extra(3, 3), 0u);
+    EXPECT_EQ(extra(0, 5), 0u);    // 5 px from (5, 5)
+    EXPECT_EQ(extra(11, 5), 0u);   // 5 px from (6, 5)
+    EXPECT_EQ(extra(5, 10), 0u);
+    uint32_t total = 0;
+    for (size_t i = 0; i < extra.size(); ++i) total += extra[i];
+    EXPECT_EQ(total, 240u * (10 * 9 - 2));  // x 1..10, y 1..9, less (6, 5) and (3, 3)
+    // A pinhole (no circle of confusion): the 8 neighbours only.
+    for (size_t i = 0; i < stats.size(); ++i) stats[i].suLo = stats[i].suHi = 0.f;
+    stats(6, 5).nEmitter = 0;
+    extra = render::emitterTopUps(stats, 256);
+    total = 0;
+    for (size_t i = 0; i < extra.size(); ++i) total += extra[i];
+    EXPECT_EQ(total, 240u * 9);
 }

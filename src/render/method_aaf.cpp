@@ -42,11 +42,12 @@ void renderAaf(const MethodContext& ctx, RenderResult& result) {
     filter::WedgeField wedges = filter::prefilterWedges(fb, wo);
     filter::AafParams params = filter::aafParams(fb, wedges, view, ao);
     Image<uint32_t> extra(W, H);
+    const Image<uint32_t> emitterExtra = emitterTopUps(stats, kEmitterEdgeSpp);
     uint64_t extraTotal = 0;
     for (size_t i = 0; i < extra.size(); ++i) {
         float need = std::max({params.sppDirect[i], params.sppIndirect[i], params.sppLens[i]});
         extra[i] = std::max(uint32_t(std::clamp(int(std::ceil(need)) - int(n0), 0, cap)),
-                            std::max(stats[i].emitterTopUp(kEmitterEdgeSpp), stats[i].mixedTopUp(kMixedTau, kMixedSpp)));
+                            std::max(emitterExtra[i], stats[i].mixedTopUp(kMixedTau, kMixedSpp)));
         extraTotal += extra[i];
     }
     result.seconds.add("prefilter", t.seconds());

@@ -112,13 +112,14 @@ void renderMaaf(const MethodContext& ctx, RenderResult& result) {
     filter::MaafParams params = filter::maafParams(fb, wedges, frames, view, mo);
     filter::AafParams rates = filter::aafParams(fb, wedges, view, filter::AafOptions());
     Image<uint32_t> extra(W, H);
+    const Image<uint32_t> emitterExtra = emitterTopUps(stats, kEmitterEdgeSpp);
     uint64_t extraTotal = 0;
     for (size_t i = 0; i < pixels; ++i) {
         // Sec. 6.2: extra samples only where the wedge degenerates at the focal plane, at the
         // AAF (MYRD14) rates, since there the filter is the central, axis-aligned one.
         float need = params.fallback[i] > 0 ? std::max({rates.sppDirect[i], rates.sppIndirect[i], rates.sppLens[i]}) : 0.f;
         extra[i] = std::max(uint32_t(std::clamp(int(std::ceil(need)) - int(n0), 0, cap)),
-                            std::max(stats[i].emitterTopUp(kEmitterEdgeSpp), stats[i].mixedTopUp(kMixedTau, kMixedSpp)));
+                            std::max(emitterExtra[i], stats[i].mixedTopUp(kMixedTau, kMixedSpp)));
         extraTotal += extra[i];
     }
     result.seconds.add("prefilter_slopes", t.seconds());

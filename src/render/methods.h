@@ -30,6 +30,13 @@ void renderAtrous(const MethodContext& ctx, RenderResult& result);
 /// 0.000357 / 0.000322 / 0.000315 at 16.1 / 16.6 / 18.4; 256 is the most efficient.
 constexpr uint32_t kEmitterEdgeSpp = 256;
 
+/// Extra samples at the edges of visible emitters, for every method: up to `target` samples for
+/// each pixel whose samples partly saw an emitter (PixelStats::emitterTopUp) and for each pixel
+/// within an emitter-seeing pixel's circle of confusion plus one pixel whose samples did not all
+/// see an emitter. Its 16 samples miss the few percent of a (defocused) emitter's light that
+/// reach such a rim pixel, and that light is many times the dark surface's own.
+Image<uint32_t> emitterTopUps(const Image<PixelStats>& stats, uint32_t target);
+
 /// Mixed pixels (PixelStats::mixedTopUp) in aaf and maaf: 71-87% of either filter's relMSE sits
 /// in pixels that mix surfaces (384x384, conference, sponza). Measured at tau 0.02 / 0.005 (384x384,
 /// 1 / (relMSE x seconds) against no top-up): aaf conference +19% / +39%, sponza +25% / +23%,

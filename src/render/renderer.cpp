@@ -1,5 +1,7 @@
 #include "render/renderer.h"
 
+#include <cmath>
+
 #include "core/error.h"
 #include "core/parallel.h"
 #include "filter/defocus.h"
@@ -25,6 +27,32 @@ void storeStats(const Image<PixelStats>& stats, const MethodContext& ctx, FrameB
                                      : scene::unoccludedIrradiance(lights, fb.position2[p], fb.normal2[p]) * kInvPi;
         }
     });
+}
+
+Image<uint32_t> emitterTopUps(const Image<PixelStats>& stats, uint32_t target) {
+    const int W = stats.width(), H = stats.height();
+    Image<uint32_t> extra(W, H);
+    parallelRows(H, [&](int y) {
+        for (int x = 0; x < W; ++x) extra(x, y) = stats(x, y).emitterTopUp(target);
+    });
+    // Emitter-seeing pixels are few (an emitter's image): scatter their rims serially. Measured
+    // (512x512, relMSE against 1024-spp references, without -> with the rims): cornell aaf
+    // 0.000198 -> 0.000133, maaf 0.000251 -> 0.000182, mc (64 spp) 0.000729 -> 0.000690;
+    // conference aaf -8%, maaf -7%; sponza -3%; +0.4-0.8 spp on average.
+    constexpr int kMaxRim = 32;
+    for (int y = 0; y < H; ++y)
+        for (int x = 0; x < W; ++x) {
+            const PixelStats& s = stats(x, y);
+            if (s.nEmitter == 0) continue;
+            const float coc = s.suLo <= s.suHi ? std::max(std::abs(s.suLo), std::abs(s.suHi)) : 0.f;
+            const int r = std::min(kMaxRim, int(std::ceil(coc)) + 1);
+            for (int yy = std::max(0, y - r); yy <= std::min(H - 1, y + r); ++yy)
+                for (int xx = std::max(0, x - r); xx <= std::min(W - 1, x + r); ++xx) {
+                    const PixelStats& q = stats(xx, yy);
+                    if (q.nEmitter < q.n && q.n < target) extra(xx, yy) = target - q.n;
+                }
+        }
+    return extra;
 }
 
 Image3f visibilityImage(const FrameBuffers& fb) {
@@ -56,9 +84,10 @@ void sampleUniform(const MethodContext& ctx, const std::string& label, Image<Pix
         [](int, int, const TracedSample&, int) {}, &progress);
     progress.done();
     // Pixels at the edge of a visible emitter get topped up, as in every method.
+    const Image<uint32_t> topUp = emitterTopUps(stats, kEmitterEdgeSpp);
     result.rays += samplePixels(
         ctx.sampler, stats, view,
-        [&](int x, int y) { return SampleRange{uint32_t(ctx.spp), stats(x, y).emitterTopUp(kEmitterEdgeSpp)}; }, false,
+        [&](int x, int y) { return SampleRange{uint32_t(ctx.spp), topUp(x, y)}; }, false,
         false, [](int, int, const TracedSample&, int) {}, nullptr);
     storeStats(stats, ctx, result.buffers);
     result.seconds.add("sampling", t.seconds());
