@@ -208,7 +208,9 @@ TEST(AtrousMethod, BeatsMonteCarloAtTheSameSamplesOnCornell) {
     render::RenderResult at = render::render(scene, o);
     EXPECT_GT(at.seconds.get("filter"), 0.0);
     EXPECT_GE(at.sppAverage, 4.0);  // plus the emitter-edge top-up
-    EXPECT_LT(at.sppAverage, 4.0 + 0.02 * render::kEmitterEdgeSpp);  // at most 2% of the pixels topped up
+    // The emitter's edge and its rim (one pixel here, the circles of confusion being below a
+    // pixel at 40x40) are topped up: under 6% of the pixels.
+    EXPECT_LT(at.sppAverage, 4.0 + 0.06 * render::kEmitterEdgeSpp);
     double eMc = metrics::relMse(mc.color, reference), eAt = metrics::relMse(at.color, reference);
     EXPECT_LT(eAt, 0.8 * eMc) << "mc " << eMc << " atrous " << eAt;
     EXPECT_GT(metrics::ssim(at.color, reference), metrics::ssim(mc.color, reference));
