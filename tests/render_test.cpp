@@ -301,3 +301,46 @@ TEST(Render, EmitterEdgesAndTheirDefocusRimsAreToppedUp) {
     for (size_t i = 0; i < extra.size(); ++i) total += extra[i];
     EXPECT_EQ(total, 240u * 9);
 }
+
+TEST(Render, EmitterRimsTakeTheirEmissionFromManyCameraRays) {
+    // Cornell at 64x64 (its light seen directly, a lens): where the emitter top-up applies, the
+    // emission plane is the mean over kEmitterEdgeRays camera rays, the same rays as the path
+    // samples' (so its first 16 agree with them exactly), and closer to a 16384-ray truth than
+    // what the pixel's own path samples saw.
+    scene::SceneDesc desc = scene::loadScene("cornell");
+    desc.camera.width = desc.camera.height = 64;
+    const scene::Scene scene(std::move(desc));
+    render::RenderOptions o;
+    o.quiet = true;
+    o.method = "mc";
+    o.spp = 16;
+    o.seed = 5;
+    const render::RenderResult r = render::render(scene, o);
+    const render::PathSampler sampler(scene, render::Camera(scene.desc().camera), scene.desc().render.indirect, 5);
+    const FrameBuffers& fb = r.buffers;
+    int rim = 0;
+    double errDense = 0, errSamples = 0;
+    for (int y = 0; y < 64; ++y)
+        for (int x = 0; x < 64; ++x) {
+            const size_t p = size_t(y) * 64 + x;
+            if (fb.spp[p] < 256) continue;  // not topped up
+            ++rim;
+            const Vec3f dense = sampler.meanEmission(x, y, render::kEmitterEdgeRays);
+            EXPECT_EQ(fb.emission[p].x, dense.x);
+            const Vec3f truth = sampler.meanEmission(x, y, 16384);
+            const Vec3f own = sampler.meanEmission(x, y, uint32_t(fb.spp[p]));  // what its samples saw
+            errDense += sqr(double(dense.x - truth.x));
+            errSamples += sqr(double(own.x - truth.x));
+        }
+    EXPECT_GT(rim, 20) << "the light's edge and rim";
+    EXPECT_LT(errDense, 0.5 * errSamples);
+    // The first 16 camera rays are the path samples' own.
+    for (int x = 20; x < 44; ++x) {
+        render::TracedSample s[16];
+        sampler.traceBatch(x, 4, 0, 16, false, s);
+        Vec3f sum(0.f);
+        for (const auto& t : s) sum += t.emission;
+        const Vec3f e = sampler.meanEmission(x, 4, 16);
+        EXPECT_NEAR(e.x, sum.x / 16.f, 1e-5f * (1.f + sum.x));
+    }
+}

@@ -61,6 +61,7 @@ void renderAaf(const MethodContext& ctx, RenderResult& result) {
             [](int, int, const TracedSample&, int) {}, &progress);
     }
     storeStats(stats, ctx, fb);
+    result.rays += denseEmission(ctx, emitterExtra, fb);
     result.seconds.add("sampling_adaptive", t.seconds());
     result.seconds.add("sampling", result.seconds.get("sampling_initial") + result.seconds.get("sampling_adaptive"));
 

@@ -143,6 +143,7 @@ void renderMaaf(const MethodContext& ctx, RenderResult& result) {
             &progress);
     }
     storeStats(stats, ctx, fb);
+    result.rays += denseEmission(ctx, emitterExtra, fb);
     result.seconds.add("sampling_adaptive", t.seconds());
     result.seconds.add("sampling", result.seconds.get("sampling_initial") + result.seconds.get("sampling_adaptive"));
 

@@ -213,4 +213,32 @@ void PathSampler::traceBatch(int x, int y, uint32_t first, uint32_t count, bool 
     }
 }
 
+Vec3f PathSampler::meanEmission(int x, int y, uint32_t count) const {
+    constexpr int K = scene::RayPacket::kSize;
+    const PixelSampler rng(m_seed, uint32_t(y) * uint32_t(m_camera.width()) + uint32_t(x));
+    Vec3f sum(0.f);
+    for (uint32_t first = 0; first < count; first += K) {
+        const int n = int(std::min<uint32_t>(K, count - first));
+        // The same dimensions as traceBatch draws, so these are its camera rays.
+        Vec2f uPix[K], uLens[K], uChoice[K];
+        rng.get2DBatch(first, uint32_t(n), kPixel, uPix);
+        if (m_camera.hasLens()) rng.get2DBatch(first, uint32_t(n), kLens, uLens);
+        if (m_needChoice) rng.get2DBatch(first, uint32_t(n), kChoice, uChoice);
+        else std::fill(uChoice, uChoice + n, Vec2f{0, 0});
+        scene::RayPacket primary;
+        for (int k = 0; k < n; ++k) {
+            Vec2f lens = m_camera.hasLens() ? concentricDisc(uLens[k].x, uLens[k].y) : Vec2f{0, 0};
+            Ray ray = m_camera.generate(float(x) + uPix[k].x, float(y) + uPix[k].y, lens);
+            primary.set(k, ray.origin, ray.direction, kInf, uChoice[k].y);
+        }
+        scene::Hit hit[K];
+        bool found[K] = {};
+        m_scene.intersect(primary, hit, found, true);
+        for (int k = 0; k < n; ++k)
+            if (found[k] && dot(hit[k].normal, primary.dir[k]) < 0)  // emitters shine from their front
+                sum += m_scene.material(hit[k].material).emission;
+    }
+    return count > 0 ? sum / float(count) : sum;
+}
+
 }  // namespace wedge::render

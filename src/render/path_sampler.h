@@ -50,6 +50,11 @@ public:
     /// samples as trace() one by one.
     void traceBatch(int x, int y, uint32_t first, uint32_t count, bool span, TracedSample* out) const;
 
+    /// The mean emitted radiance that the camera rays of samples 0 .. count-1 of pixel (x, y)
+    /// see: the emitted part of those path samples, from their primary rays alone (no light
+    /// sample, no bounce), at a fraction of their cost.
+    Vec3f meanEmission(int x, int y, uint32_t count) const;
+
     const Camera& camera() const { return m_camera; }
     const scene::Scene& scene() const { return m_scene; }
     ViewGeometry view() const;

@@ -1,5 +1,6 @@
 #include "render/renderer.h"
 
+#include <atomic>
 #include <cmath>
 
 #include "core/error.h"
@@ -55,6 +56,23 @@ Image<uint32_t> emitterTopUps(const Image<PixelStats>& stats, uint32_t target) {
     return extra;
 }
 
+uint64_t denseEmission(const MethodContext& ctx, const Image<uint32_t>& topUp, FrameBuffers& fb) {
+    std::atomic<uint64_t> rays{0};
+    parallelRows(fb.height, [&](int y) {
+        uint64_t local = 0;
+        for (int x = 0; x < fb.width; ++x) {
+            const size_t p = size_t(y) * fb.width + x;
+            if (topUp[p] == 0) continue;
+            const Vec3f e = ctx.sampler.meanEmission(x, y, kEmitterEdgeRays);
+            fb.color[p] += e - fb.emission[p];
+            fb.emission[p] = e;
+            local += kEmitterEdgeRays;
+        }
+        rays += local;
+    });
+    return rays;
+}
+
 Image3f visibilityImage(const FrameBuffers& fb) {
     Image3f v(fb.width, fb.height);
     for (size_t i = 0; i < v.size(); ++i) v[i] = Vec3f(fb.visibility[i]);
@@ -90,6 +108,7 @@ void sampleUniform(const MethodContext& ctx, const std::string& label, Image<Pix
         [&](int x, int y) { return SampleRange{uint32_t(ctx.spp), topUp(x, y)}; }, false,
         false, [](int, int, const TracedSample&, int) {}, nullptr);
     storeStats(stats, ctx, result.buffers);
+    result.rays += denseEmission(ctx, topUp, result.buffers);
     result.seconds.add("sampling", t.seconds());
 }
 
