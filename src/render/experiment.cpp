@@ -134,6 +134,8 @@ private:
         if (!m_options.quiet) std::fprintf(stderr, "experiment: %s\n", line.c_str());
     }
     void loadOrRenderReference();
+    /// relMSE net of the reference's own noise: what a noise-free reference would measure.
+    double netRelMse(const ExperimentProbe& p) const { return p.metrics.relMse - m_result.referenceNoise; }
     /// Renders `method` at `spp` (memoised per method); nullopt when the method is not available.
     const ExperimentProbe* evaluate(const std::string& method, int spp);
     void searchEqualQuality(const std::string& method, double target);
@@ -377,7 +379,7 @@ ExperimentResult Experiment::run() {
     for (auto& row : m_result.rows) {
         double err = row.probe.metrics.relMse * row.probe.seconds.get("total");
         row.efficiency = err > 0 ? 1.0 / err : 0.0;
-        double net = (row.probe.metrics.relMse - m_result.referenceNoise) * row.probe.seconds.get("total");
+        double net = netRelMse(row.probe) * row.probe.seconds.get("total");
         row.netEfficiency = net > 0 ? 1.0 / net : 0.0;
     }
 
@@ -467,7 +469,7 @@ void Experiment::writeResultsJson() const {
         j["ssim"] = row.probe.metrics.ssim;
         j["efficiency"] = row.efficiency;
         j["reference_noise_relmse"] = m_result.referenceNoise;
-        j["relmse_net"] = row.probe.metrics.relMse - m_result.referenceNoise;
+        j["relmse_net"] = netRelMse(row.probe);
         j["efficiency_net"] = row.netEfficiency;
         j["overhead"] = overhead(row.probe.seconds);
         j["scene"] = m_result.scene;
@@ -517,7 +519,7 @@ std::string Experiment::markdownTable() const {
         os << "| " << r.method << " | " << format("%.1f", p.sppAverage) << " | " << seconds(p.seconds.get("sampling"))
            << " | " << seconds(p.seconds.get("prefilter")) << " | " << seconds(p.seconds.get("filter")) << " | "
            << format("%.1f%%", 100 * overhead(p.seconds)) << " | " << seconds(p.seconds.get("total")) << " | "
-           << format("%.4g", p.metrics.relMse) << " | " << format("%.4g", p.metrics.relMse - m_result.referenceNoise)
+           << format("%.4g", p.metrics.relMse) << " | " << format("%.4g", netRelMse(p))
            << " | " << format("%.2f", p.metrics.psnr) << " | " << format("%.4f", p.metrics.ssim) << " | ";
         if (mcBase && mcBase->efficiency > 0) os << format("%.2fx mc", r.efficiency / mcBase->efficiency);
         else os << format("%.4g", r.efficiency);
@@ -654,7 +656,7 @@ void Experiment::writeHtml() const {
         std::string mark = r.setting != "base" && !r.reached ? " (bound)" : "";
         h << "<tr>" << td(htmlEscape(r.method)) << td(settingLabel(r.setting) + mark) << td(format("%.1f", r.probe.sppAverage))
           << td(seconds(r.probe.seconds.get("total"))) << td(format("%.4g", m.relMse))
-          << td(format("%.4g", m.relMse - m_result.referenceNoise)) << td(format("%.4f", m.smape))
+          << td(format("%.4g", netRelMse(r.probe))) << td(format("%.4f", m.smape))
           << td(format("%.2f", m.psnr)) << td(format("%.4f", m.ssim)) << td(format("%.4g", r.efficiency))
           << td(r.netEfficiency > 0 ? format("%.4g", r.netEfficiency) : "-") << "</tr>\n";
     }

@@ -69,6 +69,23 @@ TracedSample PathSampler::trace(int x, int y, uint32_t index, bool span) const {
     return out;
 }
 
+void PathSampler::cameraRays(const PixelSampler& rng, int x, int y, uint32_t first, int n, scene::RayPacket& primary,
+                             Vec2f* lens, float* choice, float* time) const {
+    constexpr int K = scene::RayPacket::kSize;
+    Vec2f uPix[K], uLens[K], uChoice[K];
+    rng.get2DBatch(first, uint32_t(n), kPixel, uPix);
+    if (m_camera.hasLens()) rng.get2DBatch(first, uint32_t(n), kLens, uLens);
+    if (m_needChoice) rng.get2DBatch(first, uint32_t(n), kChoice, uChoice);
+    else std::fill(uChoice, uChoice + n, Vec2f{0, 0});
+    for (int k = 0; k < n; ++k) {
+        choice[k] = uChoice[k].x;
+        time[k] = uChoice[k].y;
+        lens[k] = m_camera.hasLens() ? concentricDisc(uLens[k].x, uLens[k].y) : Vec2f{0, 0};
+        Ray ray = m_camera.generate(float(x) + uPix[k].x, float(y) + uPix[k].y, lens[k]);
+        primary.set(k, ray.origin, ray.direction, kInf, time[k]);
+    }
+}
+
 void PathSampler::traceBatch(int x, int y, uint32_t first, uint32_t count, bool span, TracedSample* outs) const {
     constexpr int K = scene::RayPacket::kSize;
     const PixelSampler rng(m_seed, uint32_t(y) * uint32_t(m_camera.width()) + uint32_t(x));
@@ -84,11 +101,7 @@ void PathSampler::traceBatch(int x, int y, uint32_t first, uint32_t count, bool 
         // The batch's random numbers, pair by pair (vectorised across samples). Dimensions that
         // do not matter are not drawn (the others do not depend on it).
         const uint32_t first16 = first + base;
-        Vec2f uPix[K], uLens[K], uChoice[K], uLight[K], uBounce[K], uBounceLight[K];
-        rng.get2DBatch(first16, uint32_t(n), kPixel, uPix);
-        if (m_camera.hasLens()) rng.get2DBatch(first16, uint32_t(n), kLens, uLens);
-        if (m_needChoice) rng.get2DBatch(first16, uint32_t(n), kChoice, uChoice);
-        else std::fill(uChoice, uChoice + n, Vec2f{0, 0});
+        Vec2f uLight[K], uBounce[K], uBounceLight[K];
         rng.get2DBatch(first16, uint32_t(n), kLight, uLight);
         if (m_indirect) {
             rng.get2DBatch(first16, uint32_t(n), kBounce, uBounce);
@@ -97,16 +110,11 @@ void PathSampler::traceBatch(int x, int y, uint32_t first, uint32_t count, bool 
 
         // Primary rays through the lens.
         scene::RayPacket primary;
+        Vec2f lens[K];
+        cameraRays(rng, x, y, first16, n, primary, lens, choice, time);
         for (int k = 0; k < n; ++k) {
             out[k] = TracedSample();
-            Vec2f pix = uPix[k];
-            choice[k] = uChoice[k].x;
-            time[k] = uChoice[k].y;
-            Vec2f lens{0, 0};
-            if (m_camera.hasLens()) lens = concentricDisc(uLens[k].x, uLens[k].y);
-            out[k].record.lens = lens;
-            Ray ray = m_camera.generate(float(x) + pix.x, float(y) + pix.y, lens);
-            primary.set(k, ray.origin, ray.direction, kInf, time[k]);
+            out[k].record.lens = lens[k];
             out[k].rays = 1;
         }
         scene::Hit hit[K];
@@ -219,18 +227,10 @@ Vec3f PathSampler::meanEmission(int x, int y, uint32_t count) const {
     Vec3f sum(0.f);
     for (uint32_t first = 0; first < count; first += K) {
         const int n = int(std::min<uint32_t>(K, count - first));
-        // The same dimensions as traceBatch draws, so these are its camera rays.
-        Vec2f uPix[K], uLens[K], uChoice[K];
-        rng.get2DBatch(first, uint32_t(n), kPixel, uPix);
-        if (m_camera.hasLens()) rng.get2DBatch(first, uint32_t(n), kLens, uLens);
-        if (m_needChoice) rng.get2DBatch(first, uint32_t(n), kChoice, uChoice);
-        else std::fill(uChoice, uChoice + n, Vec2f{0, 0});
         scene::RayPacket primary;
-        for (int k = 0; k < n; ++k) {
-            Vec2f lens = m_camera.hasLens() ? concentricDisc(uLens[k].x, uLens[k].y) : Vec2f{0, 0};
-            Ray ray = m_camera.generate(float(x) + uPix[k].x, float(y) + uPix[k].y, lens);
-            primary.set(k, ray.origin, ray.direction, kInf, uChoice[k].y);
-        }
+        Vec2f lens[K];
+        float choice[K], time[K];
+        cameraRays(rng, x, y, first, n, primary, lens, choice, time);
         scene::Hit hit[K];
         bool found[K] = {};
         m_scene.intersect(primary, hit, found, true);

@@ -68,6 +68,11 @@ private:
         uint32_t light;
     };
     LightSample sampleLight(const Vec3f& p, const Vec3f& n, Vec2f u, float choice) const;
+    /// The camera rays of samples first .. first+n-1 (n <= 16) of a pixel into `primary`, with
+    /// each sample's lens point, light choice and shutter time: what traceBatch and meanEmission
+    /// share, so that they trace the same rays.
+    void cameraRays(const PixelSampler& rng, int x, int y, uint32_t first, int n, scene::RayPacket& primary,
+                    Vec2f* lens, float* choice, float* time) const;
     Vec3f offset(const Vec3f& p, const Vec3f& n) const { return p + n * m_epsilon; }
 
     const scene::Scene& m_scene;
