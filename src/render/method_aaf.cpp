@@ -62,6 +62,7 @@ void renderAaf(const MethodContext& ctx, RenderResult& result) {
     }
     storeStats(stats, ctx, fb);
     result.rays += denseEmission(ctx, emitterExtra, fb);
+    stats = Image<PixelStats>();  // the filter's buffers reuse its pages (core/memory.h)
     result.seconds.add("sampling_adaptive", t.seconds());
     result.seconds.add("sampling", result.seconds.get("sampling_initial") + result.seconds.get("sampling_adaptive"));
 
