@@ -88,8 +88,8 @@ struct FrameBuffers {
                albedo2[p] * (direct2[p] + indirect2[p]) * coverage2[p] + rest[p];
     }
     /// The final image from filtered primary-surface light: each pixel's second surface takes
-    /// the filtered indirect light of the nearest pixel (within 2) whose primary surface it is;
-    /// its direct light stays as sampled.
+    /// the filtered direct and indirect light of the nearest pixel (within 2) whose primary
+    /// surface it is (its own samples' light where there is none).
     Image3f composeFiltered(const Image3f& direct, const Image3f& indirect) const;
 
     /// Every plane with its EXR channel names ("direct.R", "normal.X", "depth", ...).
