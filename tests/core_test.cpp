@@ -1,12 +1,10 @@
-// Core and I/O: the per-pixel sample generator's stratification and determinism, the large
-// buffers' block pool, and image files written and read back (EXR with named channels, PFM
-// orientation, PNG sRGB).
+// Core and I/O: the per-pixel sample generator's stratification and determinism, and image
+// files written and read back (EXR with named channels, PFM orientation, PNG sRGB).
 #include <gtest/gtest.h>
 
 #include <filesystem>
 
 #include "core/error.h"
-#include "core/memory.h"
 #include "core/sampler.h"
 #include "io/image_io.h"
 #include "test_util.h"
@@ -44,45 +42,6 @@ TEST(Sampler, DependsOnlyOnSeedPixelIndexAndPair) {
     EXPECT_NE(a.get2D(7, 2).x, d.get2D(7, 2).x);
     EXPECT_NE(a.get2D(7, 2).x, a.get2D(7, 3).x);
     EXPECT_EQ(reverseBits32(sobol1Reversed(12345)), sobol1(12345));
-}
-
-TEST(LargeBlocks, FreedBlocksAreSplitReusedAndMergedUntilTrimmed) {
-    trimLargeBlocks();
-    constexpr size_t MiB = size_t(1) << 20;
-    const float* base;
-    {
-        LargeVector<float> a(8 * MiB / sizeof(float), 1.f);
-        base = a.data();
-        EXPECT_EQ(reinterpret_cast<uintptr_t>(base) % detail::kHugeBlock, 0u);
-        EXPECT_EQ(keptLargeBlockBytes(), 0u);
-    }
-    EXPECT_EQ(keptLargeBlockBytes(), 8 * MiB);
-    {
-        // Two 4 MiB buffers are the two halves of the freed 8 MiB: nothing new is mapped.
-        LargeVector<float> b(4 * MiB / sizeof(float)), c(4 * MiB / sizeof(float));
-        EXPECT_EQ(keptLargeBlockBytes(), 0u);
-        EXPECT_TRUE((b.data() == base && c.data() == base + MiB) || (c.data() == base && b.data() == base + MiB));
-        std::fill(b.begin(), b.end(), 2.f);
-        std::fill(c.begin(), c.end(), 3.f);
-        EXPECT_EQ(b.back(), 2.f);
-        EXPECT_EQ(c.front(), 3.f);
-        // Smaller than 2 MiB: the heap's, not the pool's.
-        LargeVector<float> small(1000, 4.f);
-        EXPECT_EQ(keptLargeBlockBytes(), 0u);
-    }
-    // Freed, the halves merge again: one 8 MiB block serves an 8 MiB request in place.
-    EXPECT_EQ(keptLargeBlockBytes(), 8 * MiB);
-    {
-        LargeVector<float> d(7 * MiB / sizeof(float));  // rounded up to 8 MiB
-        EXPECT_EQ(d.data(), base);
-        EXPECT_EQ(keptLargeBlockBytes(), 0u);
-        LargeVector<float> e(3 * MiB / sizeof(float), 5.f);  // nothing kept: freshly mapped
-        EXPECT_NE(e.data(), base);
-        EXPECT_EQ(e[3 * MiB / sizeof(float) - 1], 5.f);
-    }
-    EXPECT_EQ(keptLargeBlockBytes(), 12 * MiB);
-    trimLargeBlocks();
-    EXPECT_EQ(keptLargeBlockBytes(), 0u);
 }
 
 TEST(ImageIo, RoundTrips) {

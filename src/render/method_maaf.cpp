@@ -134,7 +134,7 @@ void renderMaaf(const MethodContext& ctx, RenderResult& result) {
     // 3. Adaptive sampling at the focal plane. The samples of pixels with outer components are
     // kept as records too, so that each pixel's components are computed once, when all of its
     // samples are accumulated. (Most adaptive samples go to pixels without: the focal plane's
-    // fallback and the top-ups. Conference at 720x720: 106 MB of records before, 5 MB now.)
+    // fallback and the top-ups. Conference at 720x720: 106 MB of records before, 14 MB now.)
     t.reset();
     std::vector<uint64_t> extraOffset(pixels + 1, 0);
     for (size_t i = 0; i < pixels; ++i) extraOffset[i + 1] = extraOffset[i] + (outer(i) ? extra[i] : 0);
@@ -202,7 +202,8 @@ void renderMaaf(const MethodContext& ctx, RenderResult& result) {
         }
         outerPixels += outerInRow;
     });
-    // Free what the filter no longer needs, so that its buffers reuse those pages (core/memory.h).
+    // Free what the filter no longer needs before it allocates its buffers: a lower peak and
+    // fewer freshly touched pages (conference at 720x720: peak 935 -> 783 MB).
     LargeVector<filter::MaafSample>().swap(records);  // (= {} would keep the capacity)
     LargeVector<filter::MaafSample>().swap(extraRecords);
     stats = Image<PixelStats>();

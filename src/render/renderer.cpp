@@ -145,7 +145,6 @@ RenderResult render(const scene::Scene& scene, const RenderOptions& options) {
     else renderAtrous(ctx, result);
     result.sppAverage = averageSpp(result.buffers);
     result.seconds.add("total", total.seconds());
-    trimLargeBlocks();  // the next render pays for its own fresh memory (core/memory.h)
     return result;
 }
 
