@@ -1,6 +1,7 @@
 // Filter module (AAF and MAAF) on synthetic buffers: invariants of the image-space filters, the
 // separable MAAF path against a direct evaluation of the 6D kernel (eq. 22), and the component
-// construction (N = 1 is AAF's filter, eq. 2; the lens axis follows the wedge geometry).
+// construction (N = 1 is AAF's filter, eq. 2; the lens axis follows the wedge geometry), and the
+// accumulation of central-only pixels from their sums.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -314,6 +315,58 @@ TEST(MaafFilter, ConstantSignalStaysConstantAndNoNan) {
         ASSERT_TRUE(isFinite(out[i]));
         EXPECT_NEAR(out[i].x, 0.75f, 1e-4f);
     }
+}
+
+TEST(MaafAccumulator, CentralOnlyPixelsFromTheirSumsEqualTheirSamples) {
+    // renderMaaf takes eq. 23 of a pixel with the central component only on both axes (and no
+    // windows) from its pixel statistics' sums instead of its sample records, and keeps no
+    // records for its adaptive samples. Both ways must give the same accumulation, and pixels
+    // with outer components must differ from their plain means (the records matter there).
+    const int W = 6, H = 4, pairs = 3, S = 7;
+    MaafPixel central = uniformParams(pairs, false), outer = uniformParams(pairs, false);
+    for (int k = 0; k < 2; ++k) {
+        central.axis[k].pairs = 1;
+        for (int c = 0; c < pairs; ++c)  // no windows (eq. 20 without g), as renderMaaf by default
+            central.axis[k].sy[c] = central.axis[k].su[c] = outer.axis[k].sy[c] = outer.axis[k].su[c] = 0;
+    }
+    Image<MaafPixel> stored(W, H, central);
+    for (size_t p = 0; p < stored.size(); p += 3) stored[p] = outer;
+    MaafEffect params(stored);
+    MaafAccumulator bySample(params, pairs, 3), bySums(params, pairs, 3);
+    for (size_t p = 0; p < size_t(W * H); ++p) {
+        double sumVW[3] = {0, 0, 0}, sumW = 0;
+        for (int s = 0; s < S; ++s) {
+            uint32_t k = uint32_t(p * 97 + s * 7);
+            float y[2] = {rnd(k) - 0.5f, rnd(k + 1) - 0.5f}, u[2] = {rnd(k + 2) - 0.5f, rnd(k + 3) - 0.5f};
+            float v[3] = {rnd(k + 4), 2 * rnd(k + 5), 0.5f * rnd(k + 6)}, w = 0.3f + rnd(k + 7);
+            bySample.add(p, v, w, y, u, stored[p]);
+            bySums.add(p, v, w, y, u, stored[p]);
+            for (int c = 0; c < 3; ++c) sumVW[c] += double(v[c]) * w;
+            sumW += w;
+        }
+        bySample.scale(p, 1.f / S);
+        if (stored[p].axis[0].pairs == 1 && stored[p].axis[1].pairs == 1) {
+            const float mean[3] = {float(sumVW[0] / S), float(sumVW[1] / S), float(sumVW[2] / S)};
+            bySums.setCentral(p, mean, float(sumW / S));
+        } else {
+            bySums.scale(p, 1.f / S);
+        }
+    }
+    int outerPixels = 0;
+    for (size_t p = 0; p < size_t(W * H); ++p) {
+        const int bands = bySample.bands(p, 0) * bySample.bands(p, 1);
+        ASSERT_EQ(bands, stored[p].axis[0].pairs == 1 ? 1 : 25);
+        for (int i = 0; i < bands * 4; ++i)
+            EXPECT_NEAR(bySums.pixel(p)[i], bySample.pixel(p)[i], 1e-5f * (1.f + std::abs(bySample.pixel(p)[i])));
+        if (bands > 1) {
+            ++outerPixels;
+            // The outer bands hold cos/sin-weighted sums that the plain means cannot give.
+            float outerMagnitude = 0;
+            for (int i = 4; i < bands * 4; ++i) outerMagnitude += std::abs(bySample.pixel(p)[i]);
+            EXPECT_GT(outerMagnitude, 0.05f);
+        }
+    }
+    EXPECT_EQ(outerPixels, 8);
 }
 
 namespace {
