@@ -54,6 +54,8 @@ const char* kPlaneScene = R"({
   "objects": [{"type": "quad", "corner": [-4, 0, 4], "edge1": [8, 0, 0], "edge2": [0, 0, -8], "material": "grey"}],
   "render": {"spp": 256, "seed": 3, "indirect": false}
 })";
+/// The corners of kPlaneScene's light (it faces down: cross(edge1, edge2) = -y).
+const std::vector<Vec3f> kPlaneLight = {{-0.3f, 1, -0.5f}, {0.7f, 1, -0.5f}, {0.7f, 1, 0.5f}, {-0.3f, 1, 0.5f}};
 
 }  // namespace
 
@@ -67,15 +69,13 @@ TEST(Render, PlaneUnderParallelogramMatchesClosedForm) {
     render::RenderOptions o;
     o.quiet = true;
     render::RenderResult r = renderJson(kPlaneScene, o);
-    // Light corners (the light faces down: cross(edge1, edge2) = -y).
-    std::vector<Vec3f> poly = {{-0.3f, 1, -0.5f}, {0.7f, 1, -0.5f}, {0.7f, 1, 0.5f}, {-0.3f, 1, 0.5f}};
     const Vec3f albedo(0.5f, 0.6f, 0.7f);
     double sumRel = 0, maxRel = 0;
     int n = 0;
     for (int y = 0; y < r.color.height(); ++y)
         for (int x = 0; x < r.color.width(); ++x) {
             Vec3f p = r.buffers.position(x, y);
-            double e = 10.0 * polygonIrradiance(p, {0, 1, 0}, poly);
+            double e = 10.0 * polygonIrradiance(p, {0, 1, 0}, kPlaneLight);
             for (int c = 0; c < 3; ++c) {
                 double expected = albedo[c] * kInvPi * e;
                 double rel = std::abs(r.color(x, y)[c] - expected) / expected;
@@ -102,7 +102,6 @@ TEST(Render, ShadingNormalsOfAnObjSetTheLightCosine) {
     render::RenderOptions o;
     o.quiet = true;
     render::RenderResult r = renderJson(json, o);
-    std::vector<Vec3f> poly = {{-0.3f, 1, -0.5f}, {0.7f, 1, -0.5f}, {0.7f, 1, 0.5f}, {-0.3f, 1, 0.5f}};
     const Vec3f lean(0.5f, 0.8660254f, 0.f);
     double sumRel = 0, sumFlat = 0;
     int n = 0;
@@ -110,8 +109,8 @@ TEST(Render, ShadingNormalsOfAnObjSetTheLightCosine) {
         for (int x = 0; x < r.color.width(); ++x) {
             Vec3f p = r.buffers.position(x, y);
             // The whole light stays above the leaning normal's horizon over the visible plane.
-            double e = 10.0 * polygonIrradiance(p, lean, poly) * kInvPi;
-            double flat = 10.0 * polygonIrradiance(p, {0, 1, 0}, poly) * kInvPi;
+            double e = 10.0 * polygonIrradiance(p, lean, kPlaneLight) * kInvPi;
+            double flat = 10.0 * polygonIrradiance(p, {0, 1, 0}, kPlaneLight) * kInvPi;
             sumRel += std::abs(r.buffers.direct(x, y).x - e) / e;
             sumFlat += std::abs(flat - e) / e;
             EXPECT_NEAR(r.buffers.normal(x, y).x, lean.x, 1e-4f);
