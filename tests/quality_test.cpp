@@ -114,6 +114,31 @@ TEST(MaafQuality, AllEffectsBeatsMonteCarloAtItsAverageSpp) {
     EXPECT_LT(maaf.relmse, 0.5 * mc.relmse) << "maaf " << maaf.relmse << " at " << maaf.spp << " spp, mc " << mc.relmse;
 }
 
+TEST(MaafQuality, WindowAndFitOptionsReachTheFilter) {
+    // --maaf-radius and --no-maaf-fit: a wider window holds the outer components in more
+    // pixels (and fills more lit pixels with the wedge of the shadow next to them), and without
+    // the fit every pixel with a wedge gets them.
+    scene::Scene pen(scene::parseScene(kPenumbra, "penumbra.json", "."));
+    auto outerPixels = [&](int radius, bool fit) {
+        render::RenderOptions o;
+        o.quiet = true;
+        o.method = "maaf";
+        o.spp = 8;
+        o.maafRadius = radius;
+        o.maafFit = fit;
+        render::RenderResult r = render::render(pen, o);
+        for (const auto& [key, value] : r.extra)
+            if (key == "maaf_outer_component_pixels") return value;
+        ADD_FAILURE() << "no maaf_outer_component_pixels";
+        return -1.0;
+    };
+    const double narrow = outerPixels(10, true), wide = outerPixels(40, true);
+    // Measured: 0, 4320 (all of its pixels with a wedge), 2658 and 4320.
+    EXPECT_LT(narrow, wide);
+    EXPECT_LT(narrow, outerPixels(10, false));
+    EXPECT_LE(wide, outerPixels(40, false));
+}
+
 TEST(MaafQuality, NotWorseThanAafFilterAtEqualSamples) {
     // Both filters on the same 16 samples per pixel (no adaptive samples).
     Rendered maaf = cornell().run("maaf", 16, 2, 0);

@@ -1,7 +1,9 @@
-// wedge analyze spectrum|coverage|table: the flatland Fourier analysis of Wu et al. 2017, Secs. 3-5
-// (see docs/analysis.md). spectrum: the Fig. 4 light field and its FFT with the predicted wedge
-// slopes; coverage: eqs. 14-15 for one filter and wedge, beside the closed forms (eqs. 16, 18)
-// and their corrections; table: Tables 1-2 and Fig. 6 as CSV and PNG.
+// wedge analyze spectrum|coverage|table|penumbra: the flatland Fourier analysis of Wu et al. 2017,
+// Secs. 3-5 (see docs/analysis.md). spectrum: the Fig. 4 light field and its FFT with the
+// predicted wedge slopes; coverage: eqs. 14-15 for one filter and wedge, beside the closed forms
+// (eqs. 16, 18) and their corrections; table: Tables 1-2 and Fig. 6 as CSV and PNG; penumbra:
+// the renderer's MAAF filter across a penumbra for 1, 3, 5 and 7 components (Fig. 10 as bias
+// and noise).
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -12,6 +14,7 @@
 
 #include "analysis/coverage.h"
 #include "analysis/flatland.h"
+#include "analysis/penumbra.h"
 #include "io/plot.h"
 #include "analysis/tables.h"
 #include "apps/wedge/commands.h"
@@ -215,6 +218,90 @@ void runTable(const TableArgs& a) {
     for (const auto& f : r.files) std::printf("wrote %s\n", f.c_str());
 }
 
+// --- penumbra ------------------------------------------------------------------------------
+
+struct PenumbraArgs {
+    analysis::PenumbraSetup setup;
+    std::string weights = "sampling", output, csv;
+};
+
+void runPenumbra(PenumbraArgs a) {
+    using namespace analysis;
+    a.setup.weights = a.weights == "eq10"   ? filter::MaafWeights::Eq10
+                      : a.weights == "unit" ? filter::MaafWeights::Unit
+                                            : filter::MaafWeights::Sampling;
+    validatePenumbra(a.setup);
+    if (!a.output.empty()) io::checkOutputPath(a.output, {".png"});
+    if (!a.csv.empty()) io::checkOutputPath(a.csv, {".csv"});
+    const PenumbraSetup& s = a.setup;
+    std::vector<PenumbraResponse> rs;
+    for (int pairs = 1; pairs <= filter::kMaafMaxPairs; ++pairs) rs.push_back(penumbraResponse(pairs, s));
+
+    const double width = 2 * s.slope * s.lightHalfLength;  // the penumbra's width
+    std::printf("flatland penumbra: light y in [-%g, %g] (aspect %g), edge slope s = %g (penumbra width %g), filter "
+                "wedge [%g, %g]; weights %s, spatial scale %g, window %s\n",
+                s.lightHalfLength, s.lightHalfLength, s.lightAspect, s.slope, width,
+                s.filterSMin > 0 ? s.filterSMin : s.slope, s.filterSMax > 0 ? s.filterSMax : s.slope, a.weights.c_str(),
+                s.spatialScale, s.window > 0 ? std::to_string(s.window).c_str() : "unbounded");
+    std::printf("%-11s %10s %10s %12s %26s\n", "components", "RMS bias", "hardness", "variance", "beats K=1 below (samples");
+    std::printf("%-11s %10s %10s %12s %26s\n", "", "", "(>0 hard)", "(x K=1)", "per penumbra width)");
+    for (const auto& r : rs) {
+        double rho = breakEvenDensity(r, rs[0]);
+        char beats[64];
+        if (r.components == 1) std::snprintf(beats, sizeof beats, "-");
+        else if (std::isinf(rho)) std::snprintf(beats, sizeof beats, "always");
+        else if (rho <= 0) std::snprintf(beats, sizeof beats, "never");
+        else std::snprintf(beats, sizeof beats, "%.0f", rho * width);
+        std::printf("%-11d %10.4f %+10.4f %12.3f %26s\n", r.components, r.rmsBias, r.hardness,
+                    r.variance / rs[0].variance, beats);
+    }
+    std::printf("(mean squared error at a sample density rho = bias^2 + variance / rho; expectation and variance of "
+                "the ratio estimator by quadrature, docs/analysis.md)\n");
+
+    if (!a.csv.empty()) {
+        std::ostringstream csv;
+        csv << "x,truth";
+        for (const auto& r : rs) csv << ",k" << r.components;
+        csv << "\n";
+        for (size_t t = 0; t < rs[0].x.size(); ++t) {
+            csv << rs[0].x[t] << "," << rs[0].truth[t];
+            for (const auto& r : rs) csv << "," << r.mean[t];
+            csv << "\n";
+        }
+        analysis::writeTextFile(a.csv, csv.str());
+        std::printf("wrote %s\n", a.csv.c_str());
+    }
+    if (!a.output.empty()) {
+        io::LinePlot plot;
+        plot.title = "Expected MAAF output across a penumbra";
+        plot.xLabel = "x / penumbra half-width";
+        plot.yLabel = "visibility";
+        plot.xMin = -1.25;
+        plot.xMax = 1.25;
+        plot.yMin = -0.05;
+        plot.yMax = 1.05;
+        const double halfWidth = s.slope * s.lightHalfLength;
+        io::PlotSeries truth{"exact", {}, {}, io::displayColor(0, 0, 0)};
+        truth.dash = 6;
+        for (size_t t = 0; t < rs[0].x.size(); ++t) {
+            truth.xs.push_back(rs[0].x[t] / halfWidth);
+            truth.ys.push_back(rs[0].truth[t]);
+        }
+        plot.series.push_back(truth);
+        for (size_t i = 0; i < rs.size(); ++i) {
+            io::PlotSeries ser{"K = " + std::to_string(rs[i].components) + (i == 0 ? " (AAF)" : ""), {}, {},
+                               io::rampColor(float(i) / float(rs.size()))};
+            for (size_t t = 0; t < rs[i].x.size(); ++t) {
+                ser.xs.push_back(rs[i].x[t] / halfWidth);
+                ser.ys.push_back(rs[i].mean[t]);
+            }
+            plot.series.push_back(ser);
+        }
+        io::writePng(a.output, io::renderPlot(plot));
+        std::printf("wrote %s\n", a.output.c_str());
+    }
+}
+
 }  // namespace
 
 void registerAnalyze(CLI::App& app) {
@@ -261,6 +348,23 @@ void registerAnalyze(CLI::App& app) {
     tb->add_option("--seed", ta->seed, "Seed of the random wedges")->check(CLI::Range(0LL, 4294967295LL));
     tb->add_option("-o,--output", ta->dir, "Output directory (created if missing)")->required();
     tb->callback([ta] { runTable(*ta); });
+
+    auto pa = std::make_shared<PenumbraArgs>();
+    CLI::App* pe = cmd->add_subcommand(
+        "penumbra", "The renderer's MAAF filter across a flatland penumbra for 1, 3, 5, 7 components: bias, hardness, noise (Fig. 10)");
+    pe->add_option("--light-half-length", pa->setup.lightHalfLength, "L: the light spans y in [-L, L] (default 0.5)");
+    pe->add_option("--light-aspect", pa->setup.lightAspect, "Length / width of the 2D light, which sets sigma = sqrt(area)/2 (default 1)");
+    pe->add_option("--slope", pa->setup.slope, "Slope s = d1/d2 - 1 of the occluder edge (default 0.6)");
+    pe->add_option("--smin", pa->setup.filterSMin, "The filter's wedge, smallest slope (default: the edge's)");
+    pe->add_option("--smax", pa->setup.filterSMax, "The filter's wedge, largest slope (default: the edge's)");
+    pe->add_option("--weights", pa->weights, "Component weights mu_p: sampling (default), eq10 or unit")
+        ->check(CLI::IsMember({"sampling", "eq10", "unit"}));
+    pe->add_option("--spatial-scale", pa->setup.spatialScale, "Fourier std of the spatial Gaussians / eq. 8's half-width (default sqrt 6, the renderer's)");
+    pe->add_option("--window", pa->setup.window, "Cut the filter at |x - x'| <= this (default 0: unbounded)");
+    pe->add_option("--points", pa->setup.points, "Output positions across the penumbra (default 61)");
+    pe->add_option("-o,--output", pa->output, "PNG plot of the expected edge profiles");
+    pe->add_option("--csv", pa->csv, "CSV of the expected edge profiles");
+    pe->callback([pa] { runPenumbra(*pa); });
 }
 
 }  // namespace wedge::app

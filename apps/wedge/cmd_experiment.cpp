@@ -10,6 +10,7 @@
 #include "apps/wedge/common.h"
 #include "core/error.h"
 #include "core/parallel.h"
+#include "filter/maaf.h"
 #include "render/experiment.h"
 #include "scene/scene.h"
 #include "scene/scene_loader.h"
@@ -101,6 +102,9 @@ void registerExperiment(CLI::App& app) {
         ->check(CLI::IsMember({3, 5, 7}));
     cmd->add_flag("!--no-focal-fallback", r.maafFocalFallback,
                   "maaf: keep all components where the defocus slope changes sign");
+    cmd->add_option("--maaf-radius", r.maafRadius, "maaf: spatial filter window in pixels (default 10)")
+        ->check(CLI::Range(1, filter::kMaafMaxWindowRadius));
+    cmd->add_flag("!--no-maaf-fit", r.maafFit, "maaf: all components everywhere, also where the window cannot hold them");
     cmd->add_option("--maaf-weights", r.maafWeights, "maaf: component weights mu_p (sampling, eq10 or unit)")
         ->check(CLI::IsMember({"sampling", "eq10", "unit"}));
     cmd->add_option("--atrous-iterations", r.atrousIterations, "atrous: wavelet levels")->check(CLI::Range(1, 10));

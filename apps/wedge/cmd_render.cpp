@@ -8,6 +8,7 @@
 #include "apps/wedge/common.h"
 #include "core/error.h"
 #include "core/parallel.h"
+#include "filter/maaf.h"
 #include "io/image_io.h"
 #include "render/output.h"
 #include "scene/scene.h"
@@ -74,6 +75,10 @@ void registerRender(CLI::App& app) {
                   "maaf: keep all components where the defocus slope changes sign (shows the ringing)");
     cmd->add_flag("--maaf-windows", args->options.maafWindows,
                   "maaf: weigh light and lens samples by eq. 20's Gaussian windows (biased for uniform lights)");
+    cmd->add_option("--maaf-radius", args->options.maafRadius, "maaf: spatial filter window in pixels (default 10)")
+        ->check(CLI::Range(1, filter::kMaafMaxWindowRadius));
+    cmd->add_flag("!--no-maaf-fit", args->options.maafFit,
+                  "maaf: all components everywhere, also where the window cannot hold them (the paper's configuration)");
     cmd->add_option("--maaf-weights", args->options.maafWeights,
                     "maaf: component weights mu_p: the sampling densities' spectra (default), eq. 10's Gaussian, or 1")
         ->check(CLI::IsMember({"sampling", "eq10", "unit"}));

@@ -359,7 +359,7 @@ bool neighbour(const FrameBuffers& fb, const MaafEffect& params, const AxisFrame
 /// The neighbours of pixel (x, y) along image axis `axis` within the pixel's window:
 /// ok[k + radius] where neighbour() accepts the pixel at offset k, with its a and r.
 struct Window {
-    static constexpr int kMaxRadius = 128;
+    static constexpr int kMaxRadius = kMaafMaxWindowRadius;
     int radius;
     bool ok[2 * kMaxRadius + 1];
     float a[2 * kMaxRadius + 1], r[2 * kMaxRadius + 1];

@@ -73,6 +73,7 @@
 namespace wedge::filter {
 
 constexpr int kMaafMaxPairs = 4;  // 7 components
+constexpr int kMaafMaxWindowRadius = 128;  // pixels (MaafOptions::maxRadius)
 
 /// Trivially constructible (value-initialise with {} for zeros), so that the per-pixel images
 /// of parameters are first written where they are computed.

@@ -52,6 +52,11 @@ void renderMaaf(const MethodContext& ctx, RenderResult& result) {
     else if (ctx.options.maafWeights != "sampling")
         throw Error("--maaf-weights", "expected sampling, eq10 or unit, got '" + ctx.options.maafWeights + "'");
     mo.focalFallback = ctx.options.maafFocalFallback;
+    mo.maxRadius = ctx.options.maafRadius;
+    mo.fitComponents = ctx.options.maafFit;
+    if (mo.maxRadius < 1 || mo.maxRadius > filter::kMaafMaxWindowRadius)
+        throw Error("--maaf-radius", "expected 1 to " + std::to_string(filter::kMaafMaxWindowRadius) + " pixels, got " +
+                                         std::to_string(mo.maxRadius));
     if (mo.pairs < 1 || mo.pairs > filter::kMaafMaxPairs)
         throw Error("--maaf-components", "expected 1, 3, 5 or 7 components");
 

@@ -28,6 +28,8 @@ struct RenderOptions {
     int maafComponents = 5;          // 2N-1 filters per 2D/3D subspace
     bool maafFocalFallback = true;   // fall back to the central filter where the defocus slope changes sign
     bool maafWindows = false;        // eq. 20's Gaussian windows over light and lens samples
+    int maafRadius = 10;             // the spatial filter's window, pixels (NOTES: the reimplementation's 10)
+    bool maafFit = true;             // only as many components per axis as that window resolves (filter/maaf.h)
     std::string maafWeights = "sampling";  // mu_p: sampling | eq10 | unit (filter/maaf.h, "Weights")
     // à-trous
     int atrousIterations = 5;
