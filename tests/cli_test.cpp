@@ -148,6 +148,28 @@ TEST(Cli, NoLight) {
                    "lights: the scene has no light");
 }
 
+TEST(Cli, MtlTermsThatAreNotRenderedAreNamed) {
+    // Valid input that wedge does not render (specular terms, texture maps) renders, with one
+    // warning per MTL that names the materials; a plain Lambertian material is not named.
+    std::string dir = tempDir();
+    writeFile(dir + "/quad.obj",
+              "mtllib quad.mtl\nv -1 0 -1\nv 1 0 -1\nv 1 0 1\nv -1 0 1\nusemtl shiny\nf 1 4 3\nusemtl matte\nf 1 3 2\n");
+    writeFile(dir + "/quad.mtl",
+              "newmtl shiny\nKd 0.5 0.5 0.5\nKs 0.7 0.7 0.7\nmap_Kd wood.png\nnewmtl matte\nKd 0.4 0.4 0.4\n");
+    writeFile(dir + "/s.json", scene(R"({"type": "mesh", "file": "quad.obj"})"));
+    std::string err;
+    ASSERT_EQ(runWedge("render " + dir + "/s.json --quiet -o " + dir + "/x.png", nullptr, &err), 0) << err;
+    EXPECT_TRUE(fs::exists(dir + "/x.png"));
+    EXPECT_NE(err.find("warning: " + dir + "/s.json: objects[0].file: '" + dir + "/quad.obj'"), std::string::npos) << err;
+    EXPECT_NE(err.find("specular terms (Ks) of 'shiny'"), std::string::npos) << err;
+    EXPECT_NE(err.find("texture maps of 'shiny'"), std::string::npos) << err;
+    EXPECT_EQ(err.find("matte"), std::string::npos) << err;
+
+    writeFile(dir + "/quad.mtl", "newmtl shiny\nKd 0.5 0.5 0.5\nnewmtl matte\nKd 0.4 0.4 0.4\n");
+    ASSERT_EQ(runWedge("render " + dir + "/s.json --quiet -o " + dir + "/x.png", nullptr, &err), 0) << err;
+    EXPECT_EQ(err.find("warning"), std::string::npos) << err;
+}
+
 TEST(Cli, BadFlags) {
     std::string dir = tempDir();
     writeFile(dir + "/good.json", scene(kSphere));

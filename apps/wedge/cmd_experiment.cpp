@@ -58,6 +58,7 @@ void runExperiment(ExperimentArgs& a) {
 
     ThreadLimit limit(a.threads);
     scene::SceneDesc desc = scene::loadScene(o.sceneName);
+    printWarnings(desc);
     applyResolution(desc, a.resolution);
     scene::Scene scene(std::move(desc));
     render::runExperiment(scene, o);

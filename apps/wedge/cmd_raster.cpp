@@ -80,6 +80,7 @@ void runSweep(const RasterArgs& a) {
 
     ThreadLimit limit(a.threads);
     scene::SceneDesc desc = scene::loadScene(a.scene);
+    printWarnings(desc);
     applyResolution(desc, a.resolution);
     raster::SweepResult sweep = raster::sweepCache(desc, options(a, desc), a.sweep);
 
@@ -116,6 +117,7 @@ void runRaster(const RasterArgs& a) {
 
     ThreadLimit limit(a.threads);
     scene::SceneDesc desc = scene::loadScene(a.scene);
+    printWarnings(desc);
     applyResolution(desc, a.resolution);
     raster::RasterResult r = raster::renderRaster(desc, options(a, desc));
 

@@ -40,6 +40,7 @@ void runRender(const RenderArgs& a) {
 
     ThreadLimit limit(a.threads);
     scene::SceneDesc desc = scene::loadScene(a.scene);
+    printWarnings(desc);
     applyResolution(desc, a.resolution);
     scene::Scene scene(std::move(desc));
     render::RenderResult result = render::render(scene, opt);

@@ -9,6 +9,10 @@
 
 namespace wedge::app {
 
+void printWarnings(const scene::SceneDesc& desc) {
+    for (const auto& w : desc.warnings) std::fprintf(stderr, "wedge: warning: %s\n", w.c_str());
+}
+
 void applyResolution(scene::SceneDesc& desc, const std::string& resolution) {
     if (resolution.empty()) return;
     int w = 0, h = 0;

@@ -77,6 +77,7 @@ struct SceneDesc {
     std::vector<TriangleMesh> meshes;
     std::vector<Sphere> spheres;
     RenderSettings render;
+    std::vector<std::string> warnings;  // what was read but is not rendered (the CLI prints them)
 
     size_t triangleCount() const {
         size_t n = 0;

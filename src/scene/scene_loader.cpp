@@ -2,6 +2,7 @@
 
 #include <tiny_obj_loader.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -228,7 +229,7 @@ private:
             xf.radians = float((*r)[3].number()) * kDegToRad;
         }
         std::vector<ParallelogramLight> promoted;
-        loadObj(p.string(), fileNode.where(), overrideMaterial, m_desc.materials, mesh, promoted);
+        loadObj(p.string(), fileNode.where(), overrideMaterial, m_desc.materials, mesh, promoted, m_desc.warnings);
         for (auto& v : mesh.positions) v = xf.apply(v);
         for (auto& n : mesh.cornerNormals) n = xf.applyNormal(n);
         for (auto& l : promoted) {
@@ -269,7 +270,7 @@ private:
 }  // namespace
 
 void loadObj(const std::string& path, const std::string& where, int overrideMaterial, std::vector<Material>& materials,
-             TriangleMesh& mesh, std::vector<ParallelogramLight>& promoted) {
+             TriangleMesh& mesh, std::vector<ParallelogramLight>& promoted, std::vector<std::string>& warnings) {
     if (!fs::is_regular_file(path)) throw Error(where, "mesh file '" + path + "' does not exist");
     tinyobj::ObjReaderConfig config;
     config.triangulate = false;  // keep quads, so that emissive parallelograms can become lights
@@ -289,7 +290,12 @@ void loadObj(const std::string& path, const std::string& where, int overrideMate
     std::vector<uint32_t> mtlToScene;
     if (overrideMaterial < 0) {
         std::string prefix = fs::path(path).filename().string() + ":";
+        std::vector<std::string> specular, textured;
         for (const auto& m : reader.GetMaterials()) {
+            if (std::max({m.specular[0], m.specular[1], m.specular[2]}) > 0) specular.push_back(m.name);
+            if (!m.diffuse_texname.empty() || !m.bump_texname.empty() || !m.alpha_texname.empty() ||
+                !m.normal_texname.empty())
+                textured.push_back(m.name);
             Material mat;
             mat.name = prefix + m.name;
             mat.albedo = Vec3f(m.diffuse[0], m.diffuse[1], m.diffuse[2]);
@@ -298,6 +304,19 @@ void loadObj(const std::string& path, const std::string& where, int overrideMate
             mtlToScene.push_back(uint32_t(materials.size()));
             materials.push_back(mat);
         }
+        // Valid input that wedge does not render: say so once per file, naming a few materials.
+        auto list = [](const std::vector<std::string>& names) {
+            std::string s;
+            for (size_t i = 0; i < names.size() && i < 3; ++i) s += (i ? ", '" : "'") + names[i] + "'";
+            if (names.size() > 3) s += " and " + std::to_string(names.size() - 3) + " more";
+            return s;
+        };
+        std::string unused;
+        if (!specular.empty()) unused += "the specular terms (Ks) of " + list(specular);
+        if (!textured.empty()) unused += std::string(unused.empty() ? "" : "; ") + "the texture maps of " + list(textured);
+        if (!unused.empty())
+            warnings.push_back(where + ": '" + path + "': " + unused +
+                               " are not rendered (surfaces are Lambertian with the MTL's Kd)");
     }
 
     size_t vertexCount = attrib.vertices.size() / 3, normalCount = attrib.normals.size() / 3;

@@ -24,7 +24,9 @@ std::string scenesDirectory();
 
 /// Loads a Wavefront OBJ (with its MTL) into `mesh`, appending its materials to `materials`
 /// unless `overrideMaterial` >= 0. Emissive parallelogram faces become lights in `promoted`.
+/// What the MTL asks for that wedge does not render (specular terms, texture maps) is named in
+/// one line appended to `warnings`.
 void loadObj(const std::string& path, const std::string& where, int overrideMaterial, std::vector<Material>& materials,
-             TriangleMesh& mesh, std::vector<ParallelogramLight>& promoted);
+             TriangleMesh& mesh, std::vector<ParallelogramLight>& promoted, std::vector<std::string>& warnings);
 
 }  // namespace wedge::scene
