@@ -225,6 +225,58 @@ TEST(Render, ImageIsBitIdenticalOnOneAndTwoThreads) {
     }
 }
 
+TEST(Render, SamplesTracedAgainAreTheSamplesAndFindTheirSlot) {
+    // What lets MAAF trace the samples of its outer-component pixels again instead of keeping
+    // them: the sampler is deterministic per pixel and sample index (whatever the batches and
+    // the span queries), and PixelStats::slotOf finds the slot add() put each sample in. A plank
+    // over a floor under a thin lens: defocused silhouettes give pixels two surfaces.
+    const char* json = R"({
+      "camera": {"position": [0, 1.2, 2.2], "look_at": [0, 0.3, 0], "up": [0, 1, 0], "fov_y": 40, "resolution": [32, 32],
+                 "aperture_radius": 0.12, "focus_distance": 1.2},
+      "materials": {"grey": {"albedo": [0.6, 0.6, 0.6]}, "red": {"albedo": [0.7, 0.2, 0.1]}},
+      "lights": [{"type": "parallelogram", "corner": [-0.4, 2, -0.4], "edge1": [0.8, 0, 0], "edge2": [0, 0, 0.8], "radiance": [20, 20, 20]}],
+      "objects": [{"type": "quad", "corner": [-3, 0, 3], "edge1": [6, 0, 0], "edge2": [0, 0, -6], "material": "grey"},
+                  {"type": "box", "min": [-0.5, 0.4, -0.1], "max": [0.5, 0.45, 0.1], "material": "red"}],
+      "render": {"spp": 16, "seed": 5, "indirect": true}
+    })";
+    scene::Scene s(parse(json));
+    render::Camera camera(s.desc().camera);
+    render::PathSampler sampler(s, camera, true, 11);
+    const ViewGeometry view = sampler.view();
+    constexpr uint32_t kInitial = 16, kTotal = 27;
+    int twoSurfaces = 0, secondSlotSamples = 0;
+    for (int y = 0; y < 32; ++y)
+        for (int x = 0; x < 32; ++x) {
+            // As the method samples: 16 with spans (slopes), then adaptive samples without.
+            render::PixelStats ps;
+            render::TracedSample first[kTotal], again[kTotal];
+            sampler.traceBatch(x, y, 0, kInitial, true, first);
+            sampler.traceBatch(x, y, kInitial, kTotal - kInitial, false, first + kInitial);
+            int slot[kTotal];
+            for (uint32_t i = 0; i < kTotal; ++i) slot[i] = ps.add(first[i], view, i < kInitial);
+            // Traced again in other batches, without spans.
+            sampler.traceBatch(x, y, 0, 5, false, again);
+            sampler.traceBatch(x, y, 5, kTotal - 5, false, again + 5);
+            for (uint32_t i = 0; i < kTotal; ++i) {
+                const SampleRecord &a = first[i].record, &b = again[i].record;
+                ASSERT_EQ(first[i].hit, again[i].hit) << x << "," << y << " #" << i;
+                EXPECT_EQ(first[i].object, again[i].object);
+                EXPECT_EQ(first[i].occluded, again[i].occluded) << x << "," << y << " #" << i;
+                EXPECT_EQ(0, std::memcmp(&a.direct, &b.direct, sizeof(Vec3f)));
+                EXPECT_EQ(0, std::memcmp(&a.indirect, &b.indirect, sizeof(Vec3f)));
+                EXPECT_EQ(0, std::memcmp(&a.lightPoint, &b.lightPoint, sizeof(Vec3f)));
+                EXPECT_EQ(0, std::memcmp(&a.bounceDir, &b.bounceDir, sizeof(Vec3f)));
+                EXPECT_EQ(0, std::memcmp(&a.lens, &b.lens, sizeof(Vec2f)));
+                EXPECT_EQ(a.unoccluded, b.unoccluded);
+                EXPECT_EQ(ps.slotOf(again[i]), slot[i]) << x << "," << y << " #" << i;
+                secondSlotSamples += slot[i] == 1;
+            }
+            twoSurfaces += ps.slot[1].n > 0;
+        }
+    EXPECT_GT(twoSurfaces, 20);  // the test sees both slots
+    EXPECT_GT(secondSlotSamples, 100);
+}
+
 namespace {
 /// A path sample on surface `object` at depth 1 with the given direct light (albedo 1).
 render::TracedSample surfaceSample(uint32_t object, float light) {

@@ -1,11 +1,12 @@
 // --method maaf: multiple axis-aligned filters (filter/maaf.h) as in Sec. 6.2 of the paper.
-// Stages: initial sampling (16 path samples per pixel with occluder spans, held in a compact
-// form until they are accumulated);
-// prefilter: slopes over a 5x5 window, components per pixel, then the accumulation of eq. 23
-// over each pixel's samples; adaptive sampling only where the wedge degenerates at the focal
-// plane (central filter, AAF rates, at most 100 more samples); filter: eq. 21 on both image
-// axes for direct and indirect light, then multiplied by albedo; last, the defocus filter of the
-// composited radiance (filter/defocus.h).
+// Stages: initial sampling (16 path samples per pixel with occluder spans, folded into the
+// pixel statistics); prefilter: slopes over a 5x5 window and components per pixel; adaptive
+// sampling only where the wedge degenerates at the focal plane (central filter, AAF rates) and
+// the emitter and mixed-pixel top-ups; the initial samples of the pixels with outer components
+// traced again (their adaptive samples are kept when taken); then the accumulation of eq. 23
+// over each pixel's samples (the plain sums of the statistics where the pixel uses the central
+// component only); filter: eq. 21 on both image axes for direct and indirect light, then
+// multiplied by albedo; last, the defocus filter of the composited radiance (filter/defocus.h).
 #include <atomic>
 #include <cmath>
 #include <fstream>
@@ -60,12 +61,10 @@ void renderMaaf(const MethodContext& ctx, RenderResult& result) {
     if (mo.pairs < 1 || mo.pairs > filter::kMaafMaxPairs)
         throw Error("--maaf-components", "expected 1, 3, 5 or 7 components");
 
-    // Memory: two accumulators (direct, indirect), the initial sample records, per-pixel
-    // central widths, the filter's intermediate bands. Refuse before allocating more than the
-    // machine has (and again before the adaptive samples' records).
+    // Memory: two accumulators (direct, indirect), the pixel statistics, per-pixel central
+    // widths, the filter's intermediate bands. Refuse before allocating more than the machine has.
     const size_t pixels = size_t(W) * H;
     const size_t accBytes = filter::MaafAccumulator::bytes(W, H, mo.pairs, 1) + filter::MaafAccumulator::bytes(W, H, mo.pairs, 3);
-    const size_t recordBytes = pixels * n0 * sizeof(filter::MaafSample);
     const size_t otherBytes = pixels * (sizeof(PixelStats) + size_t(2 * mo.pairs) * 6 * sizeof(float) + 256);
     auto checkMemory = [&](size_t need, const char* what) {
         const size_t avail = availableMemory();
@@ -75,28 +74,20 @@ void renderMaaf(const MethodContext& ctx, RenderResult& result) {
                                              std::to_string(2 * mo.pairs - 1) + " components and " + std::to_string(n0) +
                                              " initial spp, but only " + std::to_string(avail >> 20) + " MiB are available");
     };
-    checkMemory(accBytes + recordBytes + otherBytes, "accumulations and sample records");
+    checkMemory(accBytes + otherBytes, "accumulations and pixel statistics");
     result.extra.emplace_back("maaf_components", double(2 * mo.pairs - 1));
     result.extra.emplace_back("maaf_accumulator_bytes_bound", double(accBytes));
-    result.extra.emplace_back("maaf_sample_record_bytes", double(recordBytes));
 
     Image<PixelStats> stats(W, H);
     FrameBuffers& fb = result.buffers;
-    LargeVector<filter::MaafSample> records(pixels * n0);
 
-    // 1. Initial sampling: 16 path samples with occluder spans; keep the records.
+    // 1. Initial sampling: 16 path samples with occluder spans.
     Timer t;
     {
         Progress progress("maaf initial", uint64_t(pixels) * n0, !ctx.options.quiet);
-        std::vector<uint32_t> fill(pixels, 0);
         result.rays += samplePixels(
             ctx.sampler, stats, view, [&](int, int) { return SampleRange{0, n0}; }, true, true,
-            [&](int x, int y, const TracedSample& s, int slot) {
-                size_t p = size_t(y) * W + x;
-                size_t i = p * n0 + fill[p]++;
-                records[i] = filter::MaafSample::pack(s.record, view, slot);
-            },
-            &progress);
+            [](int, int, const TracedSample&, int) {}, &progress);
     }
     storeStats(stats, ctx, fb);
     result.seconds.add("sampling_initial", t.seconds());
@@ -129,23 +120,28 @@ void renderMaaf(const MethodContext& ctx, RenderResult& result) {
     }
     result.seconds.add("prefilter_slopes", t.seconds());
 
-    // Pixels whose accumulation has outer components (or windows) read their samples' records;
-    // the others use the pixel statistics' plain sums (below).
+    // Pixels whose accumulation has outer components (or windows) need their samples one by
+    // one; the others use the pixel statistics' plain sums (below).
     auto outer = [&](size_t p) {
         return mo.apertureWindows || params.direct.pairs(p, 0) > 1 || params.direct.pairs(p, 1) > 1 ||
                params.indirect.pairs(p, 0) > 1 || params.indirect.pairs(p, 1) > 1;
     };
 
-    // 3. Adaptive sampling at the focal plane. The samples of pixels with outer components are
-    // kept as records too, so that each pixel's components are computed once, when all of its
-    // samples are accumulated. (Most adaptive samples go to pixels without: the focal plane's
-    // fallback and the top-ups. Conference at 720x720: 106 MB of records before, 14 MB now.)
+    // Records of every sample of the pixels with outer components: their adaptive samples as
+    // they are taken, their initial samples traced again below. Not kept from the first stage
+    // for every pixel: those pixels are 4-19% of the 512x512 scenes, and records of all 16
+    // initial samples of every pixel were 151 MB at 512x512 (299 MB at 720x720) of memory that
+    // is slow to touch first here (README, "MAAF's sample records": peak memory at 720x720
+    // 780 -> 475 MB, total time the same or less).
+    std::vector<uint64_t> offset(pixels + 1, 0);
+    for (size_t i = 0; i < pixels; ++i) offset[i + 1] = offset[i] + (outer(i) ? n0 + extra[i] : 0);
+    checkMemory(offset[pixels] * sizeof(filter::MaafSample), "sample records of the pixels with outer components");
+    LargeVector<filter::MaafSample> records(offset[pixels]);
+    result.extra.emplace_back("maaf_sample_record_bytes", double(records.size() * sizeof(filter::MaafSample)));
+
+    // 3. Adaptive sampling at the focal plane, and the top-ups (most adaptive samples go to
+    // pixels without outer components: the focal plane's fallback and the top-ups).
     t.reset();
-    std::vector<uint64_t> extraOffset(pixels + 1, 0);
-    for (size_t i = 0; i < pixels; ++i) extraOffset[i + 1] = extraOffset[i] + (outer(i) ? extra[i] : 0);
-    const uint64_t extraRecordCount = extraOffset[pixels];
-    checkMemory(extraRecordCount * sizeof(filter::MaafSample), "adaptive sample records");
-    LargeVector<filter::MaafSample> extraRecords(extraRecordCount);
     {
         Progress progress("maaf adaptive", extraTotal, !ctx.options.quiet && extraTotal > 0);
         std::vector<uint32_t> fill(pixels, 0);
@@ -153,15 +149,40 @@ void renderMaaf(const MethodContext& ctx, RenderResult& result) {
             ctx.sampler, stats, view, [&](int x, int y) { return SampleRange{n0, extra(x, y)}; }, false, false,
             [&](int x, int y, const TracedSample& s, int slot) {
                 size_t p = size_t(y) * W + x;
-                if (extraOffset[p + 1] > extraOffset[p])
-                    extraRecords[extraOffset[p] + fill[p]++] = filter::MaafSample::pack(s.record, view, slot);
+                if (offset[p + 1] > offset[p]) records[offset[p] + n0 + fill[p]++] = filter::MaafSample::pack(s.record, view, slot);
             },
             &progress);
     }
     storeStats(stats, ctx, fb);
     result.rays += denseEmission(ctx, emitterExtra, fb);
     result.seconds.add("sampling_adaptive", t.seconds());
-    result.seconds.add("sampling", result.seconds.get("sampling_initial") + result.seconds.get("sampling_adaptive"));
+
+    // 3b. The initial samples of the pixels with outer components, traced again: the sampler is
+    // deterministic per pixel and sample index, and PixelStats::slotOf finds the surface each
+    // one went to (tests/render_test.cpp).
+    t.reset();
+    std::atomic<uint64_t> retracedRays{0};
+    parallelRows(H, [&](int y) {
+        uint64_t rays = 0;
+        TracedSample batch[16];
+        for (int x = 0; x < W; ++x) {
+            const size_t p = size_t(y) * W + x;
+            if (offset[p + 1] == offset[p]) continue;
+            for (uint32_t first = 0; first < n0; first += 16) {
+                const uint32_t n = std::min<uint32_t>(16, n0 - first);
+                ctx.sampler.traceBatch(x, y, first, n, false, batch);
+                for (uint32_t k = 0; k < n; ++k) {
+                    rays += batch[k].rays;
+                    records[offset[p] + first + k] = filter::MaafSample::pack(batch[k].record, view, stats[p].slotOf(batch[k]));
+                }
+            }
+        }
+        retracedRays += rays;
+    });
+    result.rays += retracedRays;
+    result.seconds.add("sampling_retrace", t.seconds());
+    result.seconds.add("sampling", result.seconds.get("sampling_initial") + result.seconds.get("sampling_adaptive") +
+                                       result.seconds.get("sampling_retrace"));
 
     // 2b. Accumulation of eq. 23 over the samples on each pixel's primary surface, as means.
     t.reset();
@@ -198,8 +219,7 @@ void renderMaaf(const MethodContext& ctx, RenderResult& result) {
                 accIndirect.add(p, m.indirect, 1.f, yIndirect, u, indirect);
                 ++counted;
             };
-            for (uint32_t i = 0; i < n0; ++i) accumulate(records[p * n0 + i]);
-            for (uint64_t i = extraOffset[p]; i < extraOffset[p + 1]; ++i) accumulate(extraRecords[i]);
+            for (uint64_t i = offset[p]; i < offset[p + 1]; ++i) accumulate(records[i]);
             if (counted > 0) {
                 accDirect.scale(p, 1.f / float(counted));
                 accIndirect.scale(p, 1.f / float(counted));
@@ -208,9 +228,8 @@ void renderMaaf(const MethodContext& ctx, RenderResult& result) {
         outerPixels += outerInRow;
     });
     // Free what the filter no longer needs before it allocates its buffers: a lower peak and
-    // fewer freshly touched pages (conference at 720x720: peak 935 -> 783 MB).
+    // fewer freshly touched pages.
     LargeVector<filter::MaafSample>().swap(records);  // (= {} would keep the capacity)
-    LargeVector<filter::MaafSample>().swap(extraRecords);
     stats = Image<PixelStats>();
     result.extra.emplace_back("maaf_outer_component_pixels", double(outerPixels));
     result.seconds.add("prefilter_accumulation", t.seconds());

@@ -50,8 +50,15 @@ struct PixelStats {
     /// Adds a sample; returns the surface slot it went to (0, 1) or -1 (background or a third surface).
     int add(const TracedSample& s, const ViewGeometry& view, bool slopes);
     int primary() const { return slot[1].n > slot[0].n ? 1 : 0; }
-    /// True when the sample lies on the pixel's primary surface (as far as the samples so far tell).
-    bool onPrimary(const TracedSample& s) const { return s.hit && slot[primary()].matches(s); }
+    /// The slot add() put (or would put) the sample in, once both slots exist or the sample is one
+    /// this pixel already took: slots never change after their first sample, so tracing a pixel's
+    /// sample again finds the slot it went to. -1: background or a third surface.
+    int slotOf(const TracedSample& s) const {
+        if (!s.hit) return -1;
+        for (int k = 0; k < 2; ++k)
+            if (slot[k].matches(s)) return k;
+        return -1;
+    }
     /// Extra samples that bring a pixel partly covering an emitter up to `target`: no filter can
     /// reach emitted light, and a bright edge seen by few samples dominates any relative error.
     uint32_t emitterTopUp(uint32_t target) const {
