@@ -277,6 +277,40 @@ TEST(Render, SamplesTracedAgainAreTheSamplesAndFindTheirSlot) {
     EXPECT_GT(secondSlotSamples, 100);
 }
 
+TEST(Render, MaafTracingAgainGivesTheImageOfTheRecords) {
+    // --maaf-retrace: the outer-component pixels' initial samples traced again instead of kept
+    // give the same image bit for bit (all components everywhere, so that most pixels use them).
+    const char* json = R"({
+      "camera": {"position": [0, 1.2, 2.2], "look_at": [0, 0.3, 0], "up": [0, 1, 0], "fov_y": 40, "resolution": [48, 40],
+                 "aperture_radius": 0.12, "focus_distance": 1.2},
+      "materials": {"grey": {"albedo": [0.6, 0.6, 0.6]}, "red": {"albedo": [0.7, 0.2, 0.1]}},
+      "lights": [{"type": "parallelogram", "corner": [-0.4, 2, -0.4], "edge1": [0.8, 0, 0], "edge2": [0, 0, 0.8], "radiance": [20, 20, 20]}],
+      "objects": [{"type": "quad", "corner": [-3, 0, 3], "edge1": [6, 0, 0], "edge2": [0, 0, -6], "material": "grey"},
+                  {"type": "box", "min": [-0.5, 0.4, -0.1], "max": [0.5, 0.45, 0.1], "material": "red"}],
+      "render": {"spp": 16, "seed": 5, "indirect": true}
+    })";
+    scene::Scene s(parse(json));
+    render::RenderOptions o;
+    o.quiet = true;
+    o.method = "maaf";
+    o.maafFit = false;
+    auto figure = [](const render::RenderResult& r, const std::string& key) {
+        for (const auto& [k, v] : r.extra)
+            if (k == key) return v;
+        return -1.0;
+    };
+    o.maafRetrace = false;
+    render::RenderResult kept = render::render(s, o);
+    o.maafRetrace = true;
+    render::RenderResult traced = render::render(s, o);
+    EXPECT_EQ(figure(kept, "maaf_retrace"), 0);
+    EXPECT_EQ(figure(traced, "maaf_retrace"), 1);
+    EXPECT_GT(figure(traced, "maaf_outer_component_pixels"), 0.5 * 48 * 40);
+    EXPECT_GT(traced.rays, kept.rays);  // the samples traced again
+    ASSERT_EQ(kept.color.size(), traced.color.size());
+    EXPECT_EQ(0, std::memcmp(kept.color.data(), traced.color.data(), kept.color.size() * sizeof(Vec3f)));
+}
+
 namespace {
 /// A path sample on surface `object` at depth 1 with the given direct light (albedo 1).
 render::TracedSample surfaceSample(uint32_t object, float light) {

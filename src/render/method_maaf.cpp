@@ -7,6 +7,7 @@
 // over each pixel's samples (the plain sums of the statistics where the pixel uses the central
 // component only); filter: eq. 21 on both image axes for direct and indirect light, then
 // multiplied by albedo; last, the defocus filter of the composited radiance (filter/defocus.h).
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <fstream>
@@ -75,19 +76,38 @@ void renderMaaf(const MethodContext& ctx, RenderResult& result) {
                                              " initial spp, but only " + std::to_string(avail >> 20) + " MiB are available");
     };
     checkMemory(accBytes + otherBytes, "accumulations and pixel statistics");
+    // The pixels with outer components need their initial samples one by one, and which pixels
+    // those are is known only after the prefilter. Either every pixel's initial samples are kept
+    // as 36-byte records, or those pixels' samples are traced again after the prefilter (the
+    // sampler is deterministic per pixel and sample index; bit-identical images). Records are
+    // faster where memory has been touched before (an experiment's repeated renders: conference
+    // 512x512 1.80-1.83 s against 1.88-1.89 s) and the same in a fresh process; tracing again
+    // needs 151 MB less at 512x512, 299 MB less at 720x720 (README, "MAAF's sample records").
+    // By default records unless they would take more than a quarter of the available memory.
+    const size_t initialRecordBytes = pixels * n0 * sizeof(filter::MaafSample);
+    const size_t avail = availableMemory();
+    const bool retrace = ctx.options.maafRetrace.value_or(avail > 0 && initialRecordBytes > avail / 4);
     result.extra.emplace_back("maaf_components", double(2 * mo.pairs - 1));
     result.extra.emplace_back("maaf_accumulator_bytes_bound", double(accBytes));
+    result.extra.emplace_back("maaf_retrace", retrace ? 1.0 : 0.0);
 
     Image<PixelStats> stats(W, H);
     FrameBuffers& fb = result.buffers;
+    LargeVector<filter::MaafSample> initial(retrace ? 0 : pixels * n0);
 
     // 1. Initial sampling: 16 path samples with occluder spans.
     Timer t;
     {
         Progress progress("maaf initial", uint64_t(pixels) * n0, !ctx.options.quiet);
+        std::vector<uint32_t> fill(retrace ? 0 : pixels, 0);
         result.rays += samplePixels(
             ctx.sampler, stats, view, [&](int, int) { return SampleRange{0, n0}; }, true, true,
-            [](int, int, const TracedSample&, int) {}, &progress);
+            [&](int x, int y, const TracedSample& s, int slot) {
+                if (retrace) return;
+                const size_t p = size_t(y) * W + x;
+                initial[p * n0 + fill[p]++] = filter::MaafSample::pack(s.record, view, slot);
+            },
+            &progress);
     }
     storeStats(stats, ctx, fb);
     result.seconds.add("sampling_initial", t.seconds());
@@ -127,12 +147,8 @@ void renderMaaf(const MethodContext& ctx, RenderResult& result) {
                params.indirect.pairs(p, 0) > 1 || params.indirect.pairs(p, 1) > 1;
     };
 
-    // Records of every sample of the pixels with outer components: their adaptive samples as
-    // they are taken, their initial samples traced again below. Not kept from the first stage
-    // for every pixel: those pixels are 4-19% of the 512x512 scenes, and records of all 16
-    // initial samples of every pixel were 151 MB at 512x512 (299 MB at 720x720) of memory that
-    // is slow to touch first here (README, "MAAF's sample records": peak memory at 720x720
-    // 780 -> 475 MB, total time the same or less).
+    // Records of every sample of the pixels with outer components (4-19% of the pixels in the
+    // 512x512 scenes): their adaptive samples as they are taken, their initial samples below.
     std::vector<uint64_t> offset(pixels + 1, 0);
     for (size_t i = 0; i < pixels; ++i) offset[i + 1] = offset[i] + (outer(i) ? n0 + extra[i] : 0);
     checkMemory(offset[pixels] * sizeof(filter::MaafSample), "sample records of the pixels with outer components");
@@ -157,9 +173,8 @@ void renderMaaf(const MethodContext& ctx, RenderResult& result) {
     result.rays += denseEmission(ctx, emitterExtra, fb);
     result.seconds.add("sampling_adaptive", t.seconds());
 
-    // 3b. The initial samples of the pixels with outer components, traced again: the sampler is
-    // deterministic per pixel and sample index, and PixelStats::slotOf finds the surface each
-    // one went to (tests/render_test.cpp).
+    // 3b. The initial samples of the pixels with outer components: from the records, or traced
+    // again (PixelStats::slotOf finds the surface each one went to; tests/render_test.cpp).
     t.reset();
     std::atomic<uint64_t> retracedRays{0};
     parallelRows(H, [&](int y) {
@@ -168,6 +183,10 @@ void renderMaaf(const MethodContext& ctx, RenderResult& result) {
         for (int x = 0; x < W; ++x) {
             const size_t p = size_t(y) * W + x;
             if (offset[p + 1] == offset[p]) continue;
+            if (!retrace) {
+                std::copy_n(&initial[p * n0], n0, &records[offset[p]]);
+                continue;
+            }
             for (uint32_t first = 0; first < n0; first += 16) {
                 const uint32_t n = std::min<uint32_t>(16, n0 - first);
                 ctx.sampler.traceBatch(x, y, first, n, false, batch);
@@ -179,12 +198,15 @@ void renderMaaf(const MethodContext& ctx, RenderResult& result) {
         }
         retracedRays += rays;
     });
+    LargeVector<filter::MaafSample>().swap(initial);  // (= {} would keep the capacity)
     result.rays += retracedRays;
-    result.seconds.add("sampling_retrace", t.seconds());
+    const double gather = t.seconds();
+    if (retrace) result.seconds.add("sampling_retrace", gather);
     result.seconds.add("sampling", result.seconds.get("sampling_initial") + result.seconds.get("sampling_adaptive") +
-                                       result.seconds.get("sampling_retrace"));
+                                       (retrace ? gather : 0.0));
 
-    // 2b. Accumulation of eq. 23 over the samples on each pixel's primary surface, as means.
+    // 2b. Accumulation of eq. 23 over the samples on each pixel's primary surface, as means
+    // (with the records' copy above when they were kept).
     t.reset();
     filter::MaafAccumulator accDirect(params.direct, mo.pairs, 1), accIndirect(params.indirect, mo.pairs, 3);
     result.extra.emplace_back("maaf_accumulator_bytes", double(accDirect.allocatedBytes() + accIndirect.allocatedBytes()));
@@ -232,7 +254,7 @@ void renderMaaf(const MethodContext& ctx, RenderResult& result) {
     LargeVector<filter::MaafSample>().swap(records);  // (= {} would keep the capacity)
     stats = Image<PixelStats>();
     result.extra.emplace_back("maaf_outer_component_pixels", double(outerPixels));
-    result.seconds.add("prefilter_accumulation", t.seconds());
+    result.seconds.add("prefilter_accumulation", (retrace ? 0.0 : gather) + t.seconds());
     result.seconds.add("prefilter",
                        result.seconds.get("prefilter_slopes") + result.seconds.get("prefilter_accumulation"));
 
