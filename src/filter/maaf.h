@@ -197,10 +197,11 @@ private:
 };
 
 /// A sample as MAAF's accumulation reads it: 36 bytes instead of the 64 of a SampleRecord. The
-/// adaptive samples of pixels with outer components are kept in this form until the pixel is
-/// accumulated (its initial samples are traced again then; render/method_maaf.cpp). The filter
-/// never sees samples; only the accumulations reach it. Trivially constructible, so that
-/// allocating the records touches no memory: the sampling threads first-touch their own pages.
+/// samples of pixels with outer components are kept in this form until the pixel is accumulated
+/// (render/method_maaf.cpp: the initial ones of every pixel, or those pixels' traced again).
+/// The filter never sees samples; only the accumulations reach it. Trivially constructible, so
+/// that allocating the records touches no memory: the sampling threads first-touch their own
+/// pages.
 struct MaafSample {
     float indirect[3];     // demodulated one-bounce radiance
     float lightA, lightB;  // light point relative to the light's centre, along its axes A and B
