@@ -90,6 +90,7 @@ void renderMaaf(const MethodContext& ctx, RenderResult& result) {
     result.extra.emplace_back("maaf_components", double(2 * mo.pairs - 1));
     result.extra.emplace_back("maaf_accumulator_bytes_bound", double(accBytes));
     result.extra.emplace_back("maaf_retrace", retrace ? 1.0 : 0.0);
+    result.extra.emplace_back("maaf_initial_record_bytes", retrace ? 0.0 : double(initialRecordBytes));
 
     Image<PixelStats> stats(W, H);
     FrameBuffers& fb = result.buffers;
