@@ -337,6 +337,39 @@ TEST(Render, MixedPixelsAreToppedUpByTheirRelativeVariance) {
     EXPECT_EQ(one.primary(), 0);
 }
 
+TEST(Render, DefocusWidthIsTheSmallestCircleOfConfusionAmongTheSamples) {
+    // b of the defocus filter (filter/defocus.h): the smallest |s_u| among a pixel's samples, also
+    // where they straddle the focal plane; 0 once one of them is in focus.
+    ViewGeometry view;
+    view.width = view.height = 1;
+    view.focalPixels = 100;
+    view.apertureRadius = 0.1f;
+    view.focusDistance = 2;  // s_u = 10 (1/z - 1/2)
+    auto at = [](float depth) {
+        render::TracedSample s = surfaceSample(0, 1.f);
+        s.depth = depth;
+        s.position = {0, 0, depth};
+        return s;
+    };
+    FrameBuffers fb(1, 1);
+    render::PixelStats near, straddle, inFocus;
+    for (int i = 0; i < 8; ++i) {
+        near.add(at(i % 2 ? 1.f : 0.5f), view, true);          // s_u = 5, 15
+        straddle.add(at(i % 2 ? 1.f : 10.f), view, true);      // s_u = 5, -4
+        inFocus.add(at(i % 3 ? 1.f : 2.f), view, true);        // s_u = 5, 0
+    }
+    near.store(fb, 0, 0, view);
+    EXPECT_NEAR(fb.defocus[0], 5.f, 1e-5f);
+    straddle.store(fb, 0, 0, view);
+    EXPECT_NEAR(fb.defocus[0], 4.f, 1e-5f);
+    inFocus.store(fb, 0, 0, view);
+    EXPECT_NEAR(fb.defocus[0], 0.f, 1e-5f);
+    render::PixelStats none;  // no samples with slopes
+    none.add(at(1.f), view, false);
+    none.store(fb, 0, 0, view);
+    EXPECT_EQ(fb.defocus[0], 0.f);
+}
+
 TEST(Render, EmitterEdgesAndTheirDefocusRimsAreToppedUp) {
     // 16x12 pixels of 16 samples on a dark surface; pixel (5, 5) saw an emitter with 4 of them,
     // (6, 5) with all 16, both with circles of confusion up to 2.5 px. Pixels within

@@ -16,7 +16,9 @@
 // / 0.00146 / 0.00141 / 0.00132, cornell 0.000237 / 0.000237 / 0.000228 / 0.000225 / 0.000220;
 // 2 is the last value inside the argument above.) The support is
 // b / 2 pixels: a silhouette blurred over a circle of confusion of radius 20 px is filtered over
-// 10. Where a pixel's samples straddle the focal plane, b = 0 and the filter is the identity. A
+// 10. b is the smallest |s_u| among the pixel's samples, also where they straddle the focal
+// plane (a defocused silhouette over a background beyond the focus: both layers are blurred by
+// at least b); where one of them is in focus, b = 0 and the filter is the identity. A
 // neighbour whose own b is less than half the pixel's (sharper content) is left out, and emitted
 // light is not filtered (emitter edges are sampled densely already, and next to a bright emitter
 // any spread of it dominates its neighbours' relative error).

@@ -59,6 +59,7 @@ int PixelStats::add(const TracedSample& s, const ViewGeometry& view, bool slopes
         float su = view.defocusSlope(s.hit ? s.depth : kInf);
         suLo = std::min(suLo, su);
         suHi = std::max(suHi, su);
+        suAbsMin = std::min(suAbsMin, std::abs(su));
     }
     if (!s.hit) return -1;
     for (int k = 0; k < 2; ++k)
@@ -78,7 +79,12 @@ void PixelStats::store(FrameBuffers& fb, int x, int y, const ViewGeometry& view)
     fb.emission[p] = emission * invN;
     fb.spp[p] = float(n);
     float mean = lumSum * invN;
-    fb.defocus[p] = suLo > suHi || (suLo < 0 && suHi > 0) ? 0.f : std::min(std::abs(suLo), std::abs(suHi));
+    // The smallest circle of confusion among the samples, also where they straddle the focal
+    // plane (a defocused silhouette over a background beyond the focus): 0 only where a sample
+    // is in focus. Measured against taking 0 wherever they straddle (512x512, relMSE): AAF
+    // cornell-sphere 0.000160 -> 0.000151, bunny 0.000124 -> 0.000122, MAAF 0.000200 -> 0.000190,
+    // 0.000137 -> 0.000135; cornell, conference, sponza, grids the same to 3 digits.
+    fb.defocus[p] = suLo > suHi ? 0.f : suAbsMin;
     fb.variance[p] = n > 1 ? std::max(0.f, lumSq * invN - mean * mean) / float(n - 1) : 0.f;
     Vec3f slotLight = m.rhoDirect + m.rhoIndirect + m2.rhoDirect + m2.rhoIndirect;
     fb.rest[p] = (light - slotLight) * invN;

@@ -45,6 +45,7 @@ struct PixelStats {
     float lumSum = 0, lumSq = 0;
     uint32_t n = 0, nEmitter = 0;  // nEmitter: samples that saw an emitter
     float suLo = kInf, suHi = -kInf;  // defocus slopes of every sample added with slopes (all surfaces, misses)
+    float suAbsMin = kInf;            // the smallest |defocus slope| among them
     SurfaceSlot slot[2];
 
     /// Adds a sample; returns the surface slot it went to (0, 1) or -1 (background or a third surface).
