@@ -126,11 +126,9 @@ TEST(MaafQuality, WindowAndFitOptionsReachTheFilter) {
         o.spp = 8;
         o.maafRadius = radius;
         o.maafFit = fit;
-        render::RenderResult r = render::render(pen, o);
-        for (const auto& [key, value] : r.extra)
-            if (key == "maaf_outer_component_pixels") return value;
-        ADD_FAILURE() << "no maaf_outer_component_pixels";
-        return -1.0;
+        const std::optional<double> outer = render::render(pen, o).figure("maaf_outer_component_pixels");
+        if (!outer) ADD_FAILURE() << "no maaf_outer_component_pixels";
+        return outer.value_or(-1.0);
     };
     const double narrow = outerPixels(10, true), wide = outerPixels(40, true);
     // Measured: 0, 4320 (all of its pixels with a wedge), 2658 and 4320.

@@ -285,18 +285,13 @@ TEST(Render, MaafTracingAgainGivesTheImageOfTheRecords) {
     o.quiet = true;
     o.method = "maaf";
     o.maafFit = false;
-    auto figure = [](const render::RenderResult& r, const std::string& key) {
-        for (const auto& [k, v] : r.extra)
-            if (k == key) return v;
-        return -1.0;
-    };
     o.maafRetrace = false;
     render::RenderResult kept = render::render(s, o);
     o.maafRetrace = true;
     render::RenderResult traced = render::render(s, o);
-    EXPECT_EQ(figure(kept, "maaf_retrace"), 0);
-    EXPECT_EQ(figure(traced, "maaf_retrace"), 1);
-    EXPECT_GT(figure(traced, "maaf_outer_component_pixels"), 0.5 * 32 * 32);
+    EXPECT_EQ(kept.figure("maaf_retrace"), 0.0);
+    EXPECT_EQ(traced.figure("maaf_retrace"), 1.0);
+    EXPECT_GT(traced.figure("maaf_outer_component_pixels").value_or(-1), 0.5 * 32 * 32);
     EXPECT_GT(traced.rays, kept.rays);  // the samples traced again
     ASSERT_EQ(kept.color.size(), traced.color.size());
     EXPECT_EQ(0, std::memcmp(kept.color.data(), traced.color.data(), kept.color.size() * sizeof(Vec3f)));

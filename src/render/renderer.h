@@ -51,6 +51,12 @@ struct RenderResult {
     uint64_t rays = 0;
     int threads = 0;
     std::vector<std::pair<std::string, double>> extra;  // method-specific figures for --stats
+    /// The method-specific figure `key`, if the method gave it.
+    std::optional<double> figure(const std::string& key) const {
+        for (const auto& [k, v] : extra)
+            if (k == key) return v;
+        return std::nullopt;
+    }
 };
 
 /// The methods `render` knows, in the order `wedge render --help` lists them.
