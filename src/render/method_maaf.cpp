@@ -63,7 +63,8 @@ void renderMaaf(const MethodContext& ctx, RenderResult& result) {
         throw Error("--maaf-components", "expected 1, 3, 5 or 7 components");
 
     // Memory: two accumulators (direct, indirect), the pixel statistics, per-pixel central
-    // widths, the filter's intermediate bands. Refuse before allocating more than the machine has.
+    // widths, the filter's intermediate bands, and the initial samples' records when they are
+    // kept (below). Refuse before allocating more than the machine has.
     const size_t pixels = size_t(W) * H;
     const size_t accBytes = filter::MaafAccumulator::bytes(W, H, mo.pairs, 1) + filter::MaafAccumulator::bytes(W, H, mo.pairs, 3);
     const size_t otherBytes = pixels * (sizeof(PixelStats) + size_t(2 * mo.pairs) * 6 * sizeof(float) + 256);
@@ -75,7 +76,6 @@ void renderMaaf(const MethodContext& ctx, RenderResult& result) {
                                              std::to_string(2 * mo.pairs - 1) + " components and " + std::to_string(n0) +
                                              " initial spp, but only " + std::to_string(avail >> 20) + " MiB are available");
     };
-    checkMemory(accBytes + otherBytes, "accumulations and pixel statistics");
     // The pixels with outer components need their initial samples one by one, and which pixels
     // those are is known only after the prefilter. Either every pixel's initial samples are kept
     // as 36-byte records, or those pixels' samples are traced again after the prefilter (the
@@ -83,10 +83,14 @@ void renderMaaf(const MethodContext& ctx, RenderResult& result) {
     // faster where memory has been touched before (an experiment's repeated renders: conference
     // 512x512 1.80-1.83 s against 1.88-1.89 s) and the same in a fresh process; tracing again
     // needs 151 MB less at 512x512, 299 MB less at 720x720 (README, "MAAF's sample records").
-    // By default records unless they would take more than a quarter of the available memory.
+    // By default records, unless they would take more than a quarter of the available memory or
+    // would not fit beside the rest.
     const size_t initialRecordBytes = pixels * n0 * sizeof(filter::MaafSample);
     const size_t avail = availableMemory();
-    const bool retrace = ctx.options.maafRetrace.value_or(avail > 0 && initialRecordBytes > avail / 4);
+    const bool retrace = ctx.options.maafRetrace.value_or(
+        avail > 0 && (initialRecordBytes > avail / 4 || accBytes + otherBytes + initialRecordBytes > avail));
+    checkMemory(accBytes + otherBytes + (retrace ? 0 : initialRecordBytes),
+                retrace ? "accumulations and pixel statistics" : "accumulations, pixel statistics and sample records");
     result.extra.emplace_back("maaf_components", double(2 * mo.pairs - 1));
     result.extra.emplace_back("maaf_accumulator_bytes_bound", double(accBytes));
     result.extra.emplace_back("maaf_retrace", retrace ? 1.0 : 0.0);
