@@ -54,9 +54,8 @@ PenumbraResponse penumbraResponse(int pairs, const PenumbraSetup& set) {
     for (int j = 0; j < na; ++j) a[j] = -reach + (j + 0.5) * h;
     for (int i = 0; i < ny; ++i) y[i] = -L + (i + 0.5) * (2 * L / ny);
     for (const auto& c : comps) {
-        double mu = 1;
-        if (set.weights == filter::MaafWeights::Eq10) mu = c.mu;
-        else if (set.weights == filter::MaafWeights::Sampling) mu = filter::parallelogramSpectrum(c.cy, 2 * L, 0);
+        // The renderer's mu_p for a light 2L long seen along its length.
+        const double mu = filter::componentWeight(c, set.weights, [&] { return filter::parallelogramSpectrum(c.cy, 2 * L, 0); });
         const double weight = (c.p == 0 ? 1.0 : 2.0) * mu, sx = c.sx * set.spatialScale;
         for (int j = 0; j < na; ++j) {
             const double g = weight * sx * std::exp(-0.5 * sx * sx * a[j] * a[j]);  // unit integral up to 1/sqrt(2 pi)

@@ -27,13 +27,9 @@ struct AxisInputs {
     double edge1 = 0, edge2 = 0;
 };
 
-/// mu_p: the weight of component c (maaf.h, "Weights").
-double componentWeight(const MaafComponent& c, const AxisInputs& in, MaafWeights weights) {
-    switch (weights) {
-    case MaafWeights::Eq10: return c.mu;
-    case MaafWeights::Unit: return 1.0;
-    case MaafWeights::Sampling: break;
-    }
+/// The spectrum of the densities a pixel's samples are drawn from at component c's centre: the
+/// light's (or the bounce's) along y, times the lens's along u (maaf.h, "Weights").
+double samplingSpectrum(const MaafComponent& c, const AxisInputs& in) {
     double mu = in.light ? parallelogramSpectrum(c.cy, in.edge1, in.edge2) : discSpectrum(c.cy);
     return in.lens ? mu * discSpectrum(c.cu) : mu;
 }
@@ -87,7 +83,7 @@ MaafAxis buildAxis(const AxisInputs& in, const MaafOptions& o) {
         const MaafComponent& c = comps[p];
         ax.cx[p] = float(c.cx);
         ax.sx[p] = std::max(float(c.sx) * o.spatialScale, sxFloor);
-        ax.weight[p] = float((p == 0 ? 1.0 : 2.0) * componentWeight(c, in, o.weights));
+        ax.weight[p] = float((p == 0 ? 1.0 : 2.0) * componentWeight(c, o.weights, [&] { return samplingSpectrum(c, in); }));
         ax.cy[p] = float(c.cy);
         ax.cu[p] = in.lens ? float(uSign * c.cu) : 0.f;
         ax.sy[p] = o.apertureWindows ? float(c.sy) : 0.f;  // 0: no window

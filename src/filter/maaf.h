@@ -68,6 +68,7 @@
 
 #include "core/buffers.h"
 #include "filter/filter_frames.h"
+#include "filter/maaf_components.h"
 #include "filter/wedge_field.h"
 
 namespace wedge::filter {
@@ -92,6 +93,18 @@ enum class MaafWeights {
     Eq10,      // eq. 10's Gaussian over the double wedge (a Gaussian light)
     Unit,      // every component weighs 1
 };
+
+/// mu_p of component c under `weights`; samplingSpectrum() gives the spectrum of the densities
+/// the samples are drawn from at the component's centre (called only for MaafWeights::Sampling).
+template <class SamplingSpectrum>
+double componentWeight(const MaafComponent& c, MaafWeights weights, SamplingSpectrum&& samplingSpectrum) {
+    switch (weights) {
+    case MaafWeights::Eq10: return c.mu;
+    case MaafWeights::Unit: return 1.0;
+    case MaafWeights::Sampling: break;
+    }
+    return samplingSpectrum();
+}
 
 struct MaafOptions {
     int pairs = 3;               // N: 2N-1 components per axis (--maaf-components 5)
