@@ -227,9 +227,7 @@ struct PenumbraArgs {
 
 void runPenumbra(PenumbraArgs a) {
     using namespace analysis;
-    a.setup.weights = a.weights == "eq10"   ? filter::MaafWeights::Eq10
-                      : a.weights == "unit" ? filter::MaafWeights::Unit
-                                            : filter::MaafWeights::Sampling;
+    a.setup.weights = filter::parseMaafWeights(a.weights, "--weights");
     validatePenumbra(a.setup);
     if (!a.output.empty()) io::checkOutputPath(a.output, {".png"});
     if (!a.csv.empty()) io::checkOutputPath(a.csv, {".csv"});

@@ -4,6 +4,7 @@
 
 #include <memory>
 
+#include "core/error.h"
 #include "core/parallel.h"
 #include "filter/maaf_components.h"
 
@@ -26,6 +27,17 @@ struct AxisInputs {
     bool light = false;
     double edge1 = 0, edge2 = 0;
 };
+
+}  // namespace
+
+MaafWeights parseMaafWeights(const std::string& name, const std::string& flag) {
+    if (name == "sampling") return MaafWeights::Sampling;
+    if (name == "eq10") return MaafWeights::Eq10;
+    if (name == "unit") return MaafWeights::Unit;
+    throw Error(flag, "expected sampling, eq10 or unit, got '" + name + "'");
+}
+
+namespace {
 
 /// The spectrum of the densities a pixel's samples are drawn from at component c's centre: the
 /// light's (or the bounce's) along y, times the lens's along u (maaf.h, "Weights").

@@ -63,6 +63,7 @@
 
 #include <cstddef>
 #include <functional>
+#include <string>
 #include <type_traits>
 #include <vector>
 
@@ -93,6 +94,9 @@ enum class MaafWeights {
     Eq10,      // eq. 10's Gaussian over the double wedge (a Gaussian light)
     Unit,      // every component weighs 1
 };
+
+/// "sampling", "eq10" or "unit"; throws Error naming `flag` otherwise.
+MaafWeights parseMaafWeights(const std::string& name, const std::string& flag);
 
 /// mu_p of component c under `weights`; samplingSpectrum() gives the spectrum of the densities
 /// the samples are drawn from at the component's centre (called only for MaafWeights::Sampling).

@@ -49,10 +49,7 @@ void renderMaaf(const MethodContext& ctx, RenderResult& result) {
     filter::MaafOptions mo;
     mo.pairs = (ctx.options.maafComponents + 1) / 2;
     mo.apertureWindows = ctx.options.maafWindows;
-    if (ctx.options.maafWeights == "eq10") mo.weights = filter::MaafWeights::Eq10;
-    else if (ctx.options.maafWeights == "unit") mo.weights = filter::MaafWeights::Unit;
-    else if (ctx.options.maafWeights != "sampling")
-        throw Error("--maaf-weights", "expected sampling, eq10 or unit, got '" + ctx.options.maafWeights + "'");
+    mo.weights = filter::parseMaafWeights(ctx.options.maafWeights, "--maaf-weights");
     mo.focalFallback = ctx.options.maafFocalFallback;
     mo.maxRadius = ctx.options.maafRadius;
     mo.fitComponents = ctx.options.maafFit;
