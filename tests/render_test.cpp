@@ -332,6 +332,48 @@ TEST(Render, MixedPixelsAreToppedUpByTheirRelativeVariance) {
     EXPECT_EQ(one.primary(), 0);
 }
 
+TEST(Render, APixelKeepsItsFirstSurfacesApartAndTheRestAsColour) {
+    // Five surfaces and a miss in one pixel: the slot with the most samples is the primary, the
+    // other slots become FrameBuffers::other in slot order, and the surfaces beyond the slots go
+    // to `rest`; the decomposition reproduces the Monte Carlo colour exactly.
+    ViewGeometry view;
+    view.width = view.height = 1;
+    view.focalPixels = 100;
+    const int counts[] = {3, 6, 4, 2, 1};  // samples per surface (objects 0..4)
+    render::PixelStats ps;
+    for (uint32_t object = 0; object < 5; ++object)
+        for (int i = 0; i < counts[object]; ++i) {
+            render::TracedSample s = surfaceSample(object, 0.1f + 0.2f * float(object) + 0.01f * float(i));
+            s.albedo = Vec3f(0.2f + 0.1f * float(object));
+            s.position = {0, 0, float(object)};  // each on its own plane
+            EXPECT_EQ(ps.add(s, view, false), object < uint32_t(render::PixelStats::kSlots) ? int(object) : -1);
+        }
+    render::TracedSample miss;
+    ps.add(miss, view, false);
+    ASSERT_GE(render::PixelStats::kSlots, 3);
+    FrameBuffers fb(1, 1);
+    ps.store(fb, 0, 0, view);
+    EXPECT_EQ(ps.primary(), 1);
+    EXPECT_EQ(fb.object[0], 1.f);
+    EXPECT_NEAR(fb.coverage[0], 6.f / 17.f, 1e-6f);
+    float covered = fb.coverage[0];
+    for (int k = 0; k < FrameBuffers::kOtherSurfaces; ++k) {
+        const int object = k == 0 ? 0 : k + 1;  // slot order without the primary
+        EXPECT_EQ(fb.other[k].object[0], float(object));
+        EXPECT_NEAR(fb.other[k].coverage[0], float(counts[object]) / 17.f, 1e-6f);
+        EXPECT_NEAR(fb.other[k].albedo[0].x, 0.2f + 0.1f * float(object), 1e-6f);
+        covered += fb.other[k].coverage[0];
+    }
+    EXPECT_LT(covered, 1.f - 1.5f / 17.f);  // the last surfaces and the miss are left over
+    EXPECT_GT(maxComponent(fb.rest[0]), 0.f);
+    const Vec3f mc = fb.compose(0, fb.direct[0], fb.indirect[0]);
+    const Vec3f filtered = fb.composeFiltered(fb.direct, fb.indirect)[0];  // no neighbours: own light
+    for (int c = 0; c < 3; ++c) {
+        EXPECT_NEAR(mc[c], fb.color[0][c], 1e-6f);
+        EXPECT_NEAR(filtered[c], fb.color[0][c], 1e-6f);
+    }
+}
+
 TEST(Render, DefocusWidthIsTheSmallestCircleOfConfusionAmongTheSamples) {
     // b of the defocus filter (filter/defocus.h): the smallest |s_u| among a pixel's samples, also
     // where they straddle the focal plane; 0 once one of them is in focus.

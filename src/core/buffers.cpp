@@ -7,9 +7,13 @@ namespace wedge {
 FrameBuffers::FrameBuffers(int w, int h)
     : width(w), height(h), color(w, h), emission(w, h), direct(w, h), indirect(w, h), albedo(w, h), normal(w, h),
       position(w, h), rest(w, h), depth(w, h), spp(w, h), object(w, h), coverage(w, h), variance(w, h),
-      directUnoccluded(w, h), visibility(w, h), unoccluded(w, h), albedo2(w, h), normal2(w, h), position2(w, h),
-      direct2(w, h), indirect2(w, h), directUnoccluded2(w, h), object2(w, h), coverage2(w, h), d1(w, h), sMax(w, h), sMin(w, h),
-      occluded(w, h), zMin(w, h), zMax(w, h), suMin(w, h), suMax(w, h), defocus(w, h), footprint(w, h) {}
+      directUnoccluded(w, h), visibility(w, h), unoccluded(w, h), d1(w, h), sMax(w, h), sMin(w, h),
+      occluded(w, h), zMin(w, h), zMax(w, h), suMin(w, h), suMax(w, h), defocus(w, h), footprint(w, h) {
+    for (OtherSurface& o : other) {
+        o.albedo = o.normal = o.position = o.direct = o.indirect = Image3f(w, h);
+        o.object = o.coverage = Image1f(w, h);
+    }
+}
 
 void FrameBuffers::forEachPlane(const std::function<void(const std::string&, int, const float*)>& fn) const {
     auto v3 = [&](const char* n, const Image3f& img) { fn(n, 3, &img[0].x); };
@@ -29,10 +33,13 @@ void FrameBuffers::forEachPlane(const std::function<void(const std::string&, int
     v3("direct_unoccluded", directUnoccluded);
     v1("visibility", visibility);
     v1("unoccluded", unoccluded);
-    v3("albedo2", albedo2);
-    v3("direct2", direct2);
-    v3("indirect2", indirect2);
-    v1("coverage2", coverage2);
+    for (int k = 0; k < kOtherSurfaces; ++k) {  // albedo2, direct2, ...: the second surface, then the third
+        const std::string n = std::to_string(k + 2);
+        v3(("albedo" + n).c_str(), other[k].albedo);
+        v3(("direct" + n).c_str(), other[k].direct);
+        v3(("indirect" + n).c_str(), other[k].indirect);
+        v1(("coverage" + n).c_str(), other[k].coverage);
+    }
     v1("slope.d1", d1);
     v1("slope.s1", sMax);
     v1("slope.s2", sMin);
@@ -57,29 +64,30 @@ Image3f FrameBuffers::composeFiltered(const Image3f& directF, const Image3f& ind
             size_t p = size_t(y) * width + x;
             Vec3f c = emission[p] + rest[p];
             if (object[p] >= 0) c += albedo[p] * (directF[p] + indirectF[p]) * coverage[p];
-            if (coverage2[p] > 0) {
-                // The second surface's light is the filtered light of the nearest neighbour whose
-                // primary surface it is (its own few samples otherwise). Measured, relMSE against
-                // 1024-spp references, aaf: at 384x384 conference -7%, sponza -8%, cornell -1%,
-                // grids -21%; grids at 512x512 -21%, at 192x192 +15% (bars 1-2 px wide: the
-                // neighbour's contact shadow is not this point's). Most of the remaining error of
-                // every filter is in such mixed pixels (71-87% at 384x384).
-                Vec3f d2 = direct2[p], i2 = indirect2[p];
+            // Each other surface's light is the filtered light of the nearest neighbour whose
+            // primary surface it is (its own few samples otherwise). Measured, relMSE against
+            // 1024-spp references, aaf: at 384x384 conference -7%, sponza -8%, cornell -1%, grids
+            // -21%; grids at 512x512 -21%, at 192x192 +15% (bars 1-2 px wide: the neighbour's
+            // contact shadow is not this point's).
+            for (const OtherSurface& o : other) {
+                if (o.coverage[p] <= 0) continue;
+                Vec3f d2 = o.direct[p], i2 = o.indirect[p];
+                const Vec3f n2 = o.normal[p], p2 = o.position[p];
                 float best = kInf;
                 for (int dy = -2; dy <= 2; ++dy)
                     for (int dx = -2; dx <= 2; ++dx) {
                         int xx = x + dx, yy = y + dy;
                         if (xx < 0 || yy < 0 || xx >= width || yy >= height) continue;
                         size_t q = size_t(yy) * width + xx;
-                        if (object[q] != object2[p] || dot(normal[q], normal2[p]) < kNormalCos) continue;
-                        if (std::abs(dot(position[q] - position2[p], normal[q])) > 2.f * footprint[q]) continue;
+                        if (object[q] != o.object[p] || dot(normal[q], n2) < kNormalCos) continue;
+                        if (std::abs(dot(position[q] - p2, normal[q])) > 2.f * footprint[q]) continue;
                         float dist = float(dx * dx + dy * dy);
                         if (dist >= best) continue;
                         best = dist;
                         d2 = directF[q];
                         i2 = indirectF[q];
                     }
-                c += albedo2[p] * (d2 + i2) * coverage2[p];
+                c += o.albedo[p] * (d2 + i2) * o.coverage[p];
             }
             out[p] = c;
         }

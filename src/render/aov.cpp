@@ -29,6 +29,14 @@ void writeWedgeAovs(const std::string& dir, const std::string& prefix, const Fra
     writeAov(dir, prefix + "_s2", s2);
     writeAov(dir, prefix + "_defocus_min", wedges.suMin);
     writeAov(dir, prefix + "_defocus_max", wedges.suMax);
+    writeAov(dir, prefix + "_defocus_b", fb.defocus);  // the defocus filter's circle of confusion
+    writeAov(dir, prefix + "_coverage", fb.coverage, 0.f, 1.f);  // the primary surface's share
+    Image1f rest(fb.width, fb.height);
+    for (size_t i = 0; i < rest.size(); ++i) {
+        rest[i] = fb.object[i] < 0 ? 0.f : 1.f - fb.coverage[i];
+        for (const auto& o : fb.other) rest[i] -= o.coverage[i];
+    }
+    writeAov(dir, prefix + "_rest_share", rest, 0.f, 1.f);  // samples on neither slot (third surfaces, misses)
     io::writePng((std::filesystem::path(dir) / (prefix + "_unfiltered.png")).string(), fb.color);
 }
 

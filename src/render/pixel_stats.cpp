@@ -62,19 +62,19 @@ int PixelStats::add(const TracedSample& s, const ViewGeometry& view, bool slopes
         suAbsMin = std::min(suAbsMin, std::abs(su));
     }
     if (!s.hit) return -1;
-    for (int k = 0; k < 2; ++k)
+    for (int k = 0; k < kSlots; ++k)
         if (slot[k].n == 0 || slot[k].matches(s)) {
             slot[k].add(s, view, slopes);
             return k;
         }
-    return -1;  // a third surface: only in the colour (FrameBuffers::rest)
+    return -1;  // a surface beyond the slots: only in the colour (FrameBuffers::rest)
 }
 
 void PixelStats::store(FrameBuffers& fb, int x, int y, const ViewGeometry& view) const {
     const size_t p = size_t(y) * fb.width + x;
     const float invN = n > 0 ? 1.f / float(n) : 0.f;
-    const SurfaceSlot& m = slot[primary()];
-    const SurfaceSlot& m2 = slot[1 - primary()];
+    const int primarySlot = primary();
+    const SurfaceSlot& m = slot[primarySlot];
     fb.color[p] = color * invN;
     fb.emission[p] = emission * invN;
     fb.spp[p] = float(n);
@@ -86,7 +86,8 @@ void PixelStats::store(FrameBuffers& fb, int x, int y, const ViewGeometry& view)
     // 0.000137 -> 0.000135; cornell, conference, sponza, grids the same to 3 digits.
     fb.defocus[p] = suLo > suHi ? 0.f : suAbsMin;
     fb.variance[p] = n > 1 ? std::max(0.f, lumSq * invN - mean * mean) / float(n - 1) : 0.f;
-    Vec3f slotLight = m.rhoDirect + m.rhoIndirect + m2.rhoDirect + m2.rhoIndirect;
+    Vec3f slotLight(0.f);
+    for (const SurfaceSlot& k : slot) slotLight += k.rhoDirect + k.rhoIndirect;
     fb.rest[p] = (light - slotLight) * invN;
     // Demodulate so that albedo * direct reproduces a slot's mean of albedo_s * direct_s.
     auto demodulate = [](const SurfaceSlot& s, const Vec3f& rho, const Vec3f& plain) {
@@ -94,19 +95,24 @@ void PixelStats::store(FrameBuffers& fb, int x, int y, const ViewGeometry& view)
         for (int c = 0; c < 3; ++c) out[c] = s.albedo[c] > 1e-6f ? rho[c] / s.albedo[c] : plain[c] / float(s.n);
         return out;
     };
-    if (m2.n > 0) {
-        const float inv2 = 1.f / float(m2.n);
-        fb.coverage2[p] = float(m2.n) * invN;
-        fb.albedo2[p] = m2.albedo * inv2;
-        fb.direct2[p] = demodulate(m2, m2.rhoDirect, m2.direct);
-        fb.indirect2[p] = demodulate(m2, m2.rhoIndirect, m2.indirect);
-        fb.normal2[p] = normalize(m2.normal);
-        fb.position2[p] = m2.position * inv2;
-        fb.object2[p] = float(m2.object);
-    } else {
-        fb.coverage2[p] = 0;
-        fb.albedo2[p] = fb.direct2[p] = fb.indirect2[p] = fb.normal2[p] = fb.position2[p] = Vec3f(0.f);
-        fb.object2[p] = -1;
+    for (int k = 0, o = 0; k < kSlots; ++k) {
+        if (k == primarySlot) continue;
+        const SurfaceSlot& m2 = slot[k];
+        FrameBuffers::OtherSurface& other = fb.other[o++];
+        if (m2.n > 0) {
+            const float inv2 = 1.f / float(m2.n);
+            other.coverage[p] = float(m2.n) * invN;
+            other.albedo[p] = m2.albedo * inv2;
+            other.direct[p] = demodulate(m2, m2.rhoDirect, m2.direct);
+            other.indirect[p] = demodulate(m2, m2.rhoIndirect, m2.indirect);
+            other.normal[p] = normalize(m2.normal);
+            other.position[p] = m2.position * inv2;
+            other.object[p] = float(m2.object);
+        } else {
+            other.coverage[p] = 0;
+            other.albedo[p] = other.direct[p] = other.indirect[p] = other.normal[p] = other.position[p] = Vec3f(0.f);
+            other.object[p] = -1;
+        }
     }
     if (m.n == 0) {  // nothing hit: background
         fb.albedo[p] = fb.direct[p] = fb.indirect[p] = fb.normal[p] = fb.position[p] = Vec3f(0.f);

@@ -3,11 +3,11 @@
 // initial samples (shadow slopes from occluder spans, bounce distances, defocus slopes).
 //
 // Samples are grouped by the surface they hit (object, normal within 20 degrees, tangent
-// plane): the first two surfaces a pixel sees get a slot each; the pixel's primary surface is
-// the slot with more samples, the other becomes the `...2` planes. Filters see only primary
-// surfaces, so a silhouette pixel (half bar, half floor, or a defocused edge) is never filtered
-// with one surface's neighbours as if it were all one surface; further surfaces and misses are
-// kept as an unfiltered colour (FrameBuffers::rest).
+// plane): the first kSlots surfaces a pixel sees get a slot each; the pixel's primary surface
+// is the slot with the most samples, the others become FrameBuffers::other. Filters see only
+// primary surfaces, so a silhouette pixel (half bar, half floor, or a defocused edge) is never
+// filtered with one surface's neighbours as if it were all one surface; further surfaces and
+// misses are kept as an unfiltered colour (FrameBuffers::rest).
 #pragma once
 
 #include <algorithm>
@@ -46,17 +46,25 @@ struct PixelStats {
     uint32_t n = 0, nEmitter = 0;  // nEmitter: samples that saw an emitter
     float suLo = kInf, suHi = -kInf;  // defocus slopes of every sample added with slopes (all surfaces, misses)
     float suAbsMin = kInf;            // the smallest |defocus slope| among them
-    SurfaceSlot slot[2];
+    static constexpr int kSlots = 1 + FrameBuffers::kOtherSurfaces;
+    SurfaceSlot slot[kSlots];
 
-    /// Adds a sample; returns the surface slot it went to (0, 1) or -1 (background or a third surface).
+    /// Adds a sample; returns the surface slot it went to (0 .. kSlots - 1) or -1 (background or
+    /// a surface beyond the slots).
     int add(const TracedSample& s, const ViewGeometry& view, bool slopes);
-    int primary() const { return slot[1].n > slot[0].n ? 1 : 0; }
-    /// The slot add() put (or would put) the sample in, once both slots exist or the sample is one
-    /// this pixel already took: slots never change after their first sample, so tracing a pixel's
-    /// sample again finds the slot it went to. -1: background or a third surface.
+    /// The slot with the most samples (the first of equals).
+    int primary() const {
+        int best = 0;
+        for (int k = 1; k < kSlots; ++k)
+            if (slot[k].n > slot[best].n) best = k;
+        return best;
+    }
+    /// The slot add() put (or would put) the sample in, once every slot exists or the sample is
+    /// one this pixel already took: slots never change after their first sample, so tracing a
+    /// pixel's sample again finds the slot it went to. -1: background or a surface beyond the slots.
     int slotOf(const TracedSample& s) const {
         if (!s.hit) return -1;
-        for (int k = 0; k < 2; ++k)
+        for (int k = 0; k < kSlots; ++k)
             if (slot[k].matches(s)) return k;
         return -1;
     }

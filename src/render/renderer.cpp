@@ -23,9 +23,6 @@ void storeStats(const Image<PixelStats>& stats, const MethodContext& ctx, FrameB
             fb.directUnoccluded[p] =
                 fb.object[p] < 0 ? Vec3f(0.f)
                                  : scene::unoccludedIrradiance(lights, fb.position[p], fb.normal[p]) * kInvPi;
-            fb.directUnoccluded2[p] =
-                fb.coverage2[p] <= 0 ? Vec3f(0.f)
-                                     : scene::unoccludedIrradiance(lights, fb.position2[p], fb.normal2[p]) * kInvPi;
         }
     });
 }
