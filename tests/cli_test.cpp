@@ -4,6 +4,7 @@
 
 #include <filesystem>
 
+#include "io/image_io.h"
 #include "test_util.h"
 
 using namespace wedge::test;
@@ -63,6 +64,33 @@ TEST(Cli, GoodSceneRenders) {
               0)
         << err;
     for (const char* f : {"a.png", "a.exr", "a.pfm", "s.json"}) EXPECT_TRUE(fs::exists(dir + "/" + f)) << f;
+}
+
+TEST(Cli, AovMapsShowCoverageAndTheUnfilteredShare) {
+    // A floor filling the view: one surface everywhere, so the coverage and unfiltered-share maps
+    // are uniform; a sphere over the floor adds silhouette pixels that see two surfaces.
+    const std::string floor = R"({"type": "quad", "corner": [-20, -0.5, 20], "edge1": [40, 0, 0], "edge2": [0, 0, -40], "material": "white"})";
+    auto spread = [](const std::string& png) {
+        wedge::Image3f img = wedge::io::readPng(png);
+        float lo = 1e9f, hi = -1e9f;
+        for (size_t i = 0; i < img.size(); ++i) {
+            lo = std::min(lo, img[i].x + img[i].y + img[i].z);
+            hi = std::max(hi, img[i].x + img[i].y + img[i].z);
+        }
+        return hi - lo;
+    };
+    for (bool sphere : {false, true}) {
+        std::string dir = tempDir();
+        writeFile(dir + "/s.json", scene(sphere ? kSphere + ", " + floor : floor, "[0, 1, 3]", "[0, 1.5, 0.5]"));
+        std::string err;
+        fs::create_directories(dir + "/aov");
+        ASSERT_EQ(runWedge("render " + dir + "/s.json --method aaf --quiet --resolution 24x24 --aov " + dir + "/aov", nullptr, &err), 0) << err;
+        for (const char* map : {"aaf_spp", "aaf_defocus_b", "aaf_coverage", "aaf_rest_share", "aaf_unfiltered"})
+            EXPECT_TRUE(fs::exists(dir + "/aov/" + map + ".png")) << map;
+        EXPECT_EQ(spread(dir + "/aov/aaf_rest_share.png"), 0.f);
+        if (sphere) EXPECT_GT(spread(dir + "/aov/aaf_coverage.png"), 0.1f);
+        else EXPECT_EQ(spread(dir + "/aov/aaf_coverage.png"), 0.f);
+    }
 }
 
 TEST(Cli, UnknownKey) { expectRejected(scene(kSphere, "\"render\": {", "\"bogus\": 1, \"render\": {"), "bad.json: bogus: unknown key"); }
