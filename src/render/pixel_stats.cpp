@@ -95,42 +95,39 @@ void PixelStats::store(FrameBuffers& fb, int x, int y, const ViewGeometry& view)
         for (int c = 0; c < 3; ++c) out[c] = s.albedo[c] > 1e-6f ? rho[c] / s.albedo[c] : plain[c] / float(s.n);
         return out;
     };
+    // The planes every kept surface has (the primary's in fb, the others' in fb.other).
+    auto storeSurface = [&](const SurfaceSlot& s, Image3f& albedo, Image3f& direct, Image3f& indirect, Image3f& normal,
+                            Image3f& position, Image1f& object, Image1f& coverage) {
+        if (s.n == 0) {
+            albedo[p] = direct[p] = indirect[p] = normal[p] = position[p] = Vec3f(0.f);
+            object[p] = -1;
+            coverage[p] = 0;
+            return;
+        }
+        const float inv = 1.f / float(s.n);
+        coverage[p] = float(s.n) * invN;
+        albedo[p] = s.albedo * inv;
+        direct[p] = demodulate(s, s.rhoDirect, s.direct);
+        indirect[p] = demodulate(s, s.rhoIndirect, s.indirect);
+        normal[p] = normalize(s.normal);
+        position[p] = s.position * inv;
+        object[p] = float(s.object);
+    };
     for (int k = 0, o = 0; k < kSlots; ++k) {
         if (k == primarySlot) continue;
-        const SurfaceSlot& m2 = slot[k];
         FrameBuffers::OtherSurface& other = fb.other[o++];
-        if (m2.n > 0) {
-            const float inv2 = 1.f / float(m2.n);
-            other.coverage[p] = float(m2.n) * invN;
-            other.albedo[p] = m2.albedo * inv2;
-            other.direct[p] = demodulate(m2, m2.rhoDirect, m2.direct);
-            other.indirect[p] = demodulate(m2, m2.rhoIndirect, m2.indirect);
-            other.normal[p] = normalize(m2.normal);
-            other.position[p] = m2.position * inv2;
-            other.object[p] = float(m2.object);
-        } else {
-            other.coverage[p] = 0;
-            other.albedo[p] = other.direct[p] = other.indirect[p] = other.normal[p] = other.position[p] = Vec3f(0.f);
-            other.object[p] = -1;
-        }
+        storeSurface(slot[k], other.albedo, other.direct, other.indirect, other.normal, other.position, other.object,
+                     other.coverage);
     }
+    storeSurface(m, fb.albedo, fb.direct, fb.indirect, fb.normal, fb.position, fb.object, fb.coverage);
     if (m.n == 0) {  // nothing hit: background
-        fb.albedo[p] = fb.direct[p] = fb.indirect[p] = fb.normal[p] = fb.position[p] = Vec3f(0.f);
-        fb.depth[p] = fb.coverage[p] = fb.footprint[p] = fb.visibility[p] = fb.unoccluded[p] = 0;
-        fb.object[p] = -1;
+        fb.depth[p] = fb.footprint[p] = fb.visibility[p] = fb.unoccluded[p] = 0;
         fb.d1[p] = fb.sMax[p] = fb.occluded[p] = fb.suMin[p] = fb.suMax[p] = 0;
         fb.sMin[p] = fb.zMin[p] = fb.zMax[p] = kInf;
         return;
     }
     const float invM = 1.f / float(m.n);
-    fb.coverage[p] = float(m.n) * invN;
-    fb.albedo[p] = m.albedo * invM;
-    fb.direct[p] = demodulate(m, m.rhoDirect, m.direct);
-    fb.indirect[p] = demodulate(m, m.rhoIndirect, m.indirect);
-    fb.normal[p] = normalize(m.normal);
-    fb.position[p] = m.position * invM;
     fb.depth[p] = m.depth * invM;
-    fb.object[p] = float(m.object);
     fb.unoccluded[p] = m.unoccluded * invM;
     fb.visibility[p] = m.unoccluded > 0 ? m.visible / m.unoccluded : 0.f;
     fb.footprint[p] = view.pixelFootprint(fb.depth[p]);
