@@ -58,7 +58,6 @@ namespace wedge {
 
 Image3f FrameBuffers::composeFiltered(const Image3f& directF, const Image3f& indirectF) const {
     Image3f out(width, height);
-    constexpr float kNormalCos = 0.9396926f;  // 20 degrees, as the filters' surface test
     parallelRows(height, [&](int y) {
         for (int x = 0; x < width; ++x) {
             size_t p = size_t(y) * width + x;
@@ -79,7 +78,7 @@ Image3f FrameBuffers::composeFiltered(const Image3f& directF, const Image3f& ind
                         int xx = x + dx, yy = y + dy;
                         if (xx < 0 || yy < 0 || xx >= width || yy >= height) continue;
                         size_t q = size_t(yy) * width + xx;
-                        if (object[q] != o.object[p] || dot(normal[q], n2) < kNormalCos) continue;
+                        if (object[q] != o.object[p] || dot(normal[q], n2) < kSameSurfaceCos) continue;
                         if (std::abs(dot(position[q] - p2, normal[q])) > 2.f * footprint[q]) continue;
                         float dist = float(dx * dx + dy * dy);
                         if (dist >= best) continue;

@@ -50,6 +50,10 @@ struct ViewGeometry {
     }
 };
 
+/// cos 20 degrees: two normals closer than this are one surface, for the pixel's surface slots
+/// (render/pixel_stats.h) and for every filter's neighbour test.
+constexpr float kSameSurfaceCos = 0.9396926f;
+
 /// Per-pixel planes. A pixel's samples are split by surface (object, normal within 20 degrees,
 /// tangent plane): the G-buffer planes (albedo, normal, position, depth, object) and the
 /// demodulated light (direct, indirect) describe the samples on the pixel's primary surface (the

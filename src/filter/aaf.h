@@ -26,7 +26,7 @@ struct AafOptions {
     float lensOmega = 6.f;       // 2 / sigma_u with the lens a Gaussian of sigma_u = 1/3 aperture radii
     float indirectOmega = 2.8f;  // Omega_h^max for Lambertian receivers
     int maxRadius = 10;          // pixels (NOTES: separable, radius 10 px)
-    float normalCos = 0.9396926f;  // reject neighbours whose normals differ by 20 degrees or more
+    float normalCos = kSameSurfaceCos;  // reject neighbours whose normals differ by 20 degrees or more
     float bandwidthRatio = 3.f;  // reject neighbours whose bandwidth differs by more than this factor
     float planeDistance = 2.f;   // reject neighbours farther than this many pixel sizes off the tangent plane
     float zMinPixels = 10.f;  // clamp of the bounce distance z_min, in pixel sizes (NOTES: scene-scale constant)

@@ -116,7 +116,7 @@ struct MaafOptions {
     float lensOmega = 6.f;       // Omega_u^max, lens = Gaussian of a third of its radius
     float indirectOmega = 2.8f;  // Omega_h^max of a Lambertian receiver
     int maxRadius = 10;          // pixels
-    float normalCos = 0.9396926f;
+    float normalCos = kSameSurfaceCos;
     float planeDistance = 2.f;   // pixel sizes off the tangent plane
     float zMinPixels = 10.f;  // clamp of the bounce distance z_min, in pixel sizes (NOTES: scene-scale constant)
     float bandwidthRatio = 3.f;  // reject neighbours whose central width differs by more than this factor

@@ -29,7 +29,7 @@ struct WedgeOptions {
     float ownShadowOccluded = 2.f;
     int fillRadius = 0;      // > radius: pixels still without a wedge take it from this wider window
     int focalRadius = 10;    // window half-size of the focal-plane (sign change) detection
-    float normalCos = 0.9396926f;  // cos 20 degrees
+    float normalCos = kSameSurfaceCos;  // cos 20 degrees
 };
 
 WedgeField prefilterWedges(const FrameBuffers& fb, const WedgeOptions& options);

@@ -36,7 +36,7 @@ void writeWedgeAovs(const std::string& dir, const std::string& prefix, const Fra
         rest[i] = fb.object[i] < 0 ? 0.f : 1.f - fb.coverage[i];
         for (const auto& o : fb.other) rest[i] -= o.coverage[i];
     }
-    writeAov(dir, prefix + "_rest_share", rest, 0.f, 1.f);  // samples on neither slot (third surfaces, misses)
+    writeAov(dir, prefix + "_rest_share", rest, 0.f, 1.f);  // samples on no kept surface (further surfaces, misses)
     io::writePng((std::filesystem::path(dir) / (prefix + "_unfiltered.png")).string(), fb.color);
 }
 

@@ -34,7 +34,7 @@ struct SurfaceSlot {
     /// Same surface: same object, normal within 20 degrees, and on the first sample's tangent
     /// plane (a box face in front of a parallel wall of the same mesh is another surface).
     bool matches(const TracedSample& s) const {
-        return n > 0 && s.object == object && dot(s.normal, firstNormal) >= 0.9396926f &&
+        return n > 0 && s.object == object && dot(s.normal, firstNormal) >= kSameSurfaceCos &&
                std::abs(dot(s.position - firstPosition, firstNormal)) <= planeTolerance;
     }
     void add(const TracedSample& s, const ViewGeometry& view, bool slopes);
