@@ -35,6 +35,62 @@ TEST(Sampler, EveryPowerOfTwoPrefixIsStratified) {
     }
 }
 
+TEST(Sampler, CameraPointsAreStratifiedInFourDimensionsJointly) {
+    // Unscrambled Sobol dimensions 0-3: point i is the XOR of the direction numbers v_k of i's set
+    // bits, v_k = m_k / 2^k. By hand from Joe and Kuo's m (dimension 2: 1, 3, then
+    // m_3 = m_1 ^ 4 m_1 ^ 2 m_2 = 3; dimension 3: 1, 3, 1): point 2 = v_2, point 3 = v_1 ^ v_2,
+    // point 6 = v_2 ^ v_3. Points 1-4 in Gray-code order are 1, 3, 2, 6 in index order, and these
+    // are the sequence's published first points (0.5, ...), (0.75, 0.25, ...), (0.25, 0.75, ...),
+    // (0.375, 0.375, 0.625, ...).
+    auto sobol = [](uint32_t i, int d) { return d == 0 ? reverseBits32(i) : reverseBits32(sobolReversed(i, d)); };
+    auto at = [&](uint32_t i, int d) { return double(sobol(i, d)) * 0x1p-32; };
+    const double p2[4] = {0.25, 0.75, 0.75, 0.75}, p3[4] = {0.75, 0.25, 0.25, 0.25}, p6[4] = {0.375, 0.375, 0.625, 0.875};
+    for (int d = 0; d < 4; ++d) {
+        EXPECT_EQ(at(1, d), 0.5);
+        EXPECT_EQ(at(2, d), p2[d]);
+        EXPECT_EQ(at(3, d), p3[d]);
+        EXPECT_EQ(at(6, d), p6[d]);
+    }
+    EXPECT_EQ(sobolReversed(12345, 1), sobol1Reversed(12345));
+
+    for (uint32_t pixel = 0; pixel < 40; ++pixel) {
+        PixelSampler s(23, pixel);
+        Vec2f a[16], b[16];
+        for (uint32_t first = 0; first < 256; first += 16) {
+            s.get4DBatch(first, 16, 0, a, b);
+            for (uint32_t k = 0; k < 16; ++k) {
+                // Dimensions 0-1 are the pair's 2D points; every coordinate lies in [0, 1).
+                Vec2f p = s.get2D(first + k, 0), q, r;
+                ASSERT_EQ(a[k].x, p.x);
+                ASSERT_EQ(a[k].y, p.y);
+                s.get4D(first + k, 0, q, r);
+                ASSERT_EQ(b[k].x, r.x);
+                ASSERT_EQ(b[k].y, r.y);
+                for (float v : {b[k].x, b[k].y}) ASSERT_TRUE(v >= 0.f && v < 1.f);
+            }
+            // Every 16 consecutive points from a multiple of 16 (a power-of-two block of the
+            // sequence) put one point in each of the 16 boxes that halve each of the 4 axes.
+            int box[16] = {};
+            for (uint32_t k = 0; k < 16; ++k)
+                ++box[(a[k].x >= 0.5f) * 8 + (a[k].y >= 0.5f) * 4 + (b[k].x >= 0.5f) * 2 + (b[k].y >= 0.5f)];
+            for (int k = 0; k < 16; ++k) ASSERT_EQ(box[k], 1) << pixel << " " << first;
+            // The lens pair (dimensions 2-3) is a (1,2)-sequence: 16 points, at most 2 in each
+            // elementary interval of area 1/16, and one in each of the 4x4 squares.
+            for (int j = 0; j <= 4; ++j) {
+                int c[16] = {}, sq[16] = {};
+                for (uint32_t k = 0; k < 16; ++k) {
+                    ++c[int(b[k].x * float(1 << j)) * (1 << (4 - j)) + int(b[k].y * float(1 << (4 - j)))];
+                    if (j == 0) ++sq[int(b[k].x * 4) * 4 + int(b[k].y * 4)];
+                }
+                for (int k = 0; k < 16; ++k) ASSERT_LE(c[k], 2);
+                if (j == 0) {
+                    for (int k = 0; k < 16; ++k) ASSERT_EQ(sq[k], 1);
+                }
+            }
+        }
+    }
+}
+
 TEST(Sampler, DependsOnlyOnSeedPixelIndexAndPair) {
     PixelSampler a(5, 123), b(5, 123), c(6, 123), d(5, 124);
     EXPECT_EQ(a.get2D(7, 2).x, b.get2D(7, 2).x);

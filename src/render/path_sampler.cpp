@@ -73,8 +73,10 @@ void PathSampler::cameraRays(const PixelSampler& rng, int x, int y, uint32_t fir
                              Vec2f* lens, float* choice, float* time) const {
     constexpr int K = scene::RayPacket::kSize;
     Vec2f uPix[K], uLens[K], uChoice[K];
-    rng.get2DBatch(first, uint32_t(n), kPixel, uPix);
-    if (m_camera.hasLens()) rng.get2DBatch(first, uint32_t(n), kLens, uLens);
+    // Pixel and lens positions as one 4D Sobol point, so a defocused edge (a discontinuity in
+    // (x, y, u, v) together) is stratified jointly; the pixel positions are those of a pinhole.
+    if (m_camera.hasLens()) rng.get4DBatch(first, uint32_t(n), kPixel, uPix, uLens);
+    else rng.get2DBatch(first, uint32_t(n), kPixel, uPix);
     if (m_needChoice) rng.get2DBatch(first, uint32_t(n), kChoice, uChoice);
     else std::fill(uChoice, uChoice + n, Vec2f{0, 0});
     for (int k = 0; k < n; ++k) {

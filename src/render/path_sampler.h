@@ -37,8 +37,9 @@ struct TracedSample {
 
 class PathSampler {
 public:
-    /// Dimension pairs of PixelSampler, in order of use.
-    enum Pair : uint32_t { kPixel = 0, kLens = 1, kLight = 2, kBounce = 3, kBounceLight = 4, kChoice = 5 };
+    /// Dimension pairs of PixelSampler, in order of use. kPixel draws the pixel and the lens
+    /// position together (PixelSampler::get4DBatch), which takes the place of pair 1.
+    enum Pair : uint32_t { kPixel = 0, kLight = 2, kBounce = 3, kBounceLight = 4, kChoice = 5 };
 
     PathSampler(const scene::Scene& scene, const Camera& camera, bool indirect, uint32_t seed);
 
