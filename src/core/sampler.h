@@ -138,20 +138,13 @@ public:
     /// get2D for `count` (<= 16) consecutive indices at once, as flat loops over the 16 lanes
     /// that the compiler vectorises (one pixel's batch of samples).
     void get2DBatch(uint32_t first, uint32_t count, uint32_t pair, Vec2f* out) const {
-        // Rows of the Pascal matrix mod 2: the reversed direction numbers of Sobol dimension 1.
-        static constexpr auto kPascal = [] {
-            std::array<uint32_t, 32> v{};
-            uint32_t x = 1U;
-            for (int i = 0; i < 32; ++i, x ^= x << 1) v[i] = x;
-            return v;
-        }();
         const uint32_t pairKey = m_pairKey[pair % kPairs];
         const uint32_t s0 = pairKey ^ 0xa511e9b3U, s1 = pairKey * 0x63d83595U + 1U, s2 = pairKey * 0x9c0ee1d3U + 3U;
         alignas(64) uint32_t sh[16], r[16], a[16], b[16];
         for (uint32_t k = 0; k < 16; ++k) sh[k] = reverseBits32(laineKarras(reverseBits32(first + k), s0));
         for (uint32_t k = 0; k < 16; ++k) r[k] = 0;
         for (int bit = 0; bit < 32; ++bit)
-            for (uint32_t k = 0; k < 16; ++k) r[k] ^= kPascal[bit] & (0U - ((sh[k] >> bit) & 1U));
+            for (uint32_t k = 0; k < 16; ++k) r[k] ^= kSobolReversed[0][bit] & (0U - ((sh[k] >> bit) & 1U));
         for (uint32_t k = 0; k < 16; ++k) a[k] = reverseBits32(laineKarras(sh[k], s1));
         for (uint32_t k = 0; k < 16; ++k) b[k] = reverseBits32(laineKarras(r[k], s2));
         for (uint32_t k = 0; k < count; ++k) out[k] = {toUnitFloat(a[k]), toUnitFloat(b[k])};
