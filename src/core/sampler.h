@@ -35,7 +35,7 @@ constexpr uint32_t hash32(uint32_t x) {
 }
 constexpr uint32_t hashCombine(uint32_t a, uint32_t b) { return hash32(a ^ (hash32(b) + 0x9e3779b9U + (a << 6) + (a >> 2))); }
 
-inline uint32_t reverseBits32(uint32_t x) {
+constexpr uint32_t reverseBits32(uint32_t x) {
     x = __builtin_bswap32(x);  // bytes, then bits within bytes
     x = ((x >> 1) & 0x55555555U) | ((x & 0x55555555U) << 1);
     x = ((x >> 2) & 0x33333333U) | ((x & 0x33333333U) << 2);
@@ -86,11 +86,7 @@ constexpr std::array<uint32_t, 32> sobolReversedDirections(int s, uint32_t a, st
         m[k] = v;
     }
     std::array<uint32_t, 32> r{};
-    for (int k = 1; k <= 32; ++k) {
-        uint32_t v = m[k] << (32 - k), rev = 0;  // bit-reversed in a constexpr-friendly loop
-        for (int b = 0; b < 32; ++b) rev |= ((v >> b) & 1U) << (31 - b);
-        r[k - 1] = rev;
-    }
+    for (int k = 1; k <= 32; ++k) r[k - 1] = reverseBits32(m[k] << (32 - k));
     return r;
 }
 /// Sobol dimensions 1, 2 and 3 (Joe-Kuo d = 2, 3, 4: s = 1, 2, 3; a = 0, 1, 1; m = {1}, {1, 3},
@@ -127,27 +123,20 @@ public:
     /// nestedUniformScramble(sobol_d(i)) = reverse(laineKarras(reversed sobol_d(i))), and the
     /// reversed dimension 0 is the index itself.
     Vec2f get2D(uint32_t index, uint32_t pair) const {
-        uint32_t pairKey = m_pairKey[pair % kPairs];
-        uint32_t shuffled = nestedUniformScramble(index, pairKey ^ 0xa511e9b3U);
-        uint32_t a = reverseBits32(laineKarras(shuffled, pairKey * 0x63d83595U + 1U));
-        uint32_t b = reverseBits32(laineKarras(sobol1Reversed(shuffled), pairKey * 0x9c0ee1d3U + 3U));
-        return {toUnitFloat(a), toUnitFloat(b)};
+        const Keys key = keys(pair);
+        uint32_t shuffled = nestedUniformScramble(index, key.shuffle);
+        return {scrambled(shuffled, key.dim[0]), scrambled(sobol1Reversed(shuffled), key.dim[1])};
     }
     float get1D(uint32_t index, uint32_t pair) const { return get2D(index, pair).x; }
 
     /// get2D for `count` (<= 16) consecutive indices at once, as flat loops over the 16 lanes
     /// that the compiler vectorises (one pixel's batch of samples).
     void get2DBatch(uint32_t first, uint32_t count, uint32_t pair, Vec2f* out) const {
-        const uint32_t pairKey = m_pairKey[pair % kPairs];
-        const uint32_t s0 = pairKey ^ 0xa511e9b3U, s1 = pairKey * 0x63d83595U + 1U, s2 = pairKey * 0x9c0ee1d3U + 3U;
-        alignas(64) uint32_t sh[16], r[16], a[16], b[16];
-        for (uint32_t k = 0; k < 16; ++k) sh[k] = reverseBits32(laineKarras(reverseBits32(first + k), s0));
-        for (uint32_t k = 0; k < 16; ++k) r[k] = 0;
-        for (int bit = 0; bit < 32; ++bit)
-            for (uint32_t k = 0; k < 16; ++k) r[k] ^= kSobolReversed[0][bit] & (0U - ((sh[k] >> bit) & 1U));
-        for (uint32_t k = 0; k < 16; ++k) a[k] = reverseBits32(laineKarras(sh[k], s1));
-        for (uint32_t k = 0; k < 16; ++k) b[k] = reverseBits32(laineKarras(r[k], s2));
-        for (uint32_t k = 0; k < count; ++k) out[k] = {toUnitFloat(a[k]), toUnitFloat(b[k])};
+        const Keys key = keys(pair);
+        alignas(64) uint32_t sh[16], r[16];
+        shuffleLanes(first, key.shuffle, sh);
+        sobolLanes(sh, 1, r);
+        for (uint32_t k = 0; k < count; ++k) out[k] = {scrambled(sh[k], key.dim[0]), scrambled(r[k], key.dim[1])};
     }
 
     /// The 4D point of Sobol dimensions 0-3 for sample `index`, scrambled by pair `pair`'s key:
@@ -155,26 +144,43 @@ public:
     /// shuffled index, so (a, b) is jointly stratified. Replaces pair `pair + 1`.
     void get4D(uint32_t index, uint32_t pair, Vec2f& a, Vec2f& b) const { get4DBatch(index, 1, pair, &a, &b); }
     void get4DBatch(uint32_t first, uint32_t count, uint32_t pair, Vec2f* outA, Vec2f* outB) const {
-        const uint32_t pairKey = m_pairKey[pair % kPairs];
-        const uint32_t s0 = pairKey ^ 0xa511e9b3U, s1 = pairKey * 0x63d83595U + 1U, s2 = pairKey * 0x9c0ee1d3U + 3U;
-        const uint32_t s3 = hashCombine(pairKey, 0x2c1b3c6dU), s4 = hashCombine(pairKey, 0x297a2d39U);
+        const Keys key = keys(pair);
         alignas(64) uint32_t sh[16], r1[16], r2[16], r3[16];
-        for (uint32_t k = 0; k < 16; ++k) sh[k] = reverseBits32(laineKarras(reverseBits32(first + k), s0));
-        for (uint32_t k = 0; k < 16; ++k) r1[k] = r2[k] = r3[k] = 0;
-        for (int bit = 0; bit < 32; ++bit)
-            for (uint32_t k = 0; k < 16; ++k) {
-                uint32_t mask = 0U - ((sh[k] >> bit) & 1U);
-                r1[k] ^= kSobolReversed[0][bit] & mask;
-                r2[k] ^= kSobolReversed[1][bit] & mask;
-                r3[k] ^= kSobolReversed[2][bit] & mask;
-            }
+        shuffleLanes(first, key.shuffle, sh);
+        sobolLanes(sh, 1, r1);
+        sobolLanes(sh, 2, r2);
+        sobolLanes(sh, 3, r3);
         for (uint32_t k = 0; k < count; ++k) {
-            outA[k] = {toUnitFloat(reverseBits32(laineKarras(sh[k], s1))), toUnitFloat(reverseBits32(laineKarras(r1[k], s2)))};
-            outB[k] = {toUnitFloat(reverseBits32(laineKarras(r2[k], s3))), toUnitFloat(reverseBits32(laineKarras(r3[k], s4)))};
+            outA[k] = {scrambled(sh[k], key.dim[0]), scrambled(r1[k], key.dim[1])};
+            outB[k] = {scrambled(r2[k], key.dim[2]), scrambled(r3[k], key.dim[3])};
         }
     }
 
 private:
+    /// A pair's seeds: the index shuffle and one nested uniform scramble per Sobol dimension
+    /// (dimensions 0-1 are the ones get2D uses).
+    struct Keys {
+        uint32_t shuffle, dim[4];
+    };
+    Keys keys(uint32_t pair) const {
+        const uint32_t pairKey = m_pairKey[pair % kPairs];
+        return {pairKey ^ 0xa511e9b3U,
+                {pairKey * 0x63d83595U + 1U, pairKey * 0x9c0ee1d3U + 3U, hashCombine(pairKey, 0x2c1b3c6dU),
+                 hashCombine(pairKey, 0x297a2d39U)}};
+    }
+    /// The shuffled indices of first .. first+15, bits reversed (= reversed Sobol dimension 0).
+    static void shuffleLanes(uint32_t first, uint32_t seed, uint32_t* sh) {
+        for (uint32_t k = 0; k < 16; ++k) sh[k] = reverseBits32(laineKarras(reverseBits32(first + k), seed));
+    }
+    /// Reversed Sobol dimension d (1..3) of 16 shuffled indices, as masked XORs the compiler vectorises.
+    static void sobolLanes(const uint32_t* sh, int d, uint32_t* r) {
+        for (uint32_t k = 0; k < 16; ++k) r[k] = 0;
+        for (int bit = 0; bit < 32; ++bit)
+            for (uint32_t k = 0; k < 16; ++k) r[k] ^= kSobolReversed[d - 1][bit] & (0U - ((sh[k] >> bit) & 1U));
+    }
+    /// A reversed Sobol value through its nested uniform scramble, as a float in [0, 1).
+    static float scrambled(uint32_t reversed, uint32_t seed) { return toUnitFloat(reverseBits32(laineKarras(reversed, seed))); }
+
     uint32_t m_pairKey[kPairs];
 };
 
