@@ -114,6 +114,16 @@ TEST(ExperimentCommand, WritesRowsAndASelfContainedReport) {
         if (r["method"] == "mc" && r["setting"] == "base") {
             EXPECT_LT(noise, 0.5 * relmse);
         }
+        // Base rows split the net relMSE into variance (from a render with another seed) and
+        // squared bias. Monte Carlo has no bias: its variance is nearly all of its net relMSE.
+        ASSERT_EQ(r.contains("variance_relmse"), r["setting"] == "base") << r.dump();
+        if (r["setting"] != "base") continue;
+        const double variance = r["variance_relmse"].get<double>(), net = r["relmse_net"].get<double>();
+        EXPECT_GT(variance, 0.0);
+        EXPECT_NEAR(r["bias2_relmse"].get<double>(), net - variance, 1e-12);
+        if (r["method"] == "mc") {
+            EXPECT_LT(std::abs(net - variance), 0.3 * variance) << r.dump();
+        }
     }
     for (const auto& r : rows) {
         if (r["method"] == "atrous") {
@@ -136,6 +146,7 @@ TEST(ExperimentCommand, WritesRowsAndASelfContainedReport) {
     EXPECT_NE(html.find("speedup"), std::string::npos);
     EXPECT_NE(html.find("its own noise"), std::string::npos);
     EXPECT_NE(html.find("net relMSE"), std::string::npos);
+    EXPECT_NE(html.find("bias&sup2;"), std::string::npos);
     EXPECT_TRUE(fs::is_regular_file(dir + "/table.md"));
 }
 

@@ -125,6 +125,46 @@ TEST(Metrics, RegionErrorsSplitTheErrorByPixelClass) {
     // Edge pixels: around the background and the mixed pixel, and columns 4..7 along the border.
     EXPECT_GT(r[2].pixels, 0.3);
     EXPECT_LT(r[4].pixels + r[3].pixels, 0.7);
+    for (const auto& c : r) EXPECT_EQ(c.variance, 0.0) << "no variance map given";
+
+    // A variance map is averaged over each class's pixels: 3 on the background pixel, 1 elsewhere
+    // except 5 at the interior pixel (3, 3).
+    Image1f variance(W, H, 1.f);
+    variance(0, 0) = 3.f;
+    variance(3, 3) = 5.f;
+    auto v = regionErrors(test, ref, object, coverage, defocus, 2, 0.f, &variance);
+    EXPECT_NEAR(v[0].variance, 3.0, 1e-12);
+    EXPECT_NEAR(v[1].variance, 1.0, 1e-12);
+    EXPECT_NEAR(v[4].variance, 1.0 + 4.0 / (v[4].pixels * W * H), 1e-9);
+    for (size_t k = 0; k < r.size(); ++k) EXPECT_EQ(v[k].relMse, r[k].relMse);
+}
+
+TEST(Metrics, SeedVarianceSplitsNoiseFromBias) {
+    // Two renders of a constant 1 with a bias of 0.1 and independent Gaussian noise of sigma 0.2:
+    // relMSE against the truth is (0.01 + 0.04) / 1.01, the variance part 0.04 / 1.01, the
+    // squared bias 0.01 / 1.01. 64x64x3 values: the estimates are within a few percent.
+    const int W = 64, H = 64;
+    const float bias = 0.1f, sigma = 0.2f;
+    std::mt19937 rng(7);
+    std::normal_distribution<float> noise(0.f, sigma);
+    Image3f truth = constant(W, H, 1.f), a(W, H), b(W, H);
+    for (size_t i = 0; i < a.size(); ++i)
+        for (int c = 0; c < 3; ++c) {
+            a[i][c] = 1.f + bias + noise(rng);
+            b[i][c] = 1.f + bias + noise(rng);
+        }
+    const double expectVar = double(sigma) * sigma / 1.01, expectBias2 = double(bias) * bias / 1.01;
+    const double var = seedVariance(a, b, truth);
+    EXPECT_NEAR(var, expectVar, 0.05 * expectVar);
+    EXPECT_NEAR(relMse(a, truth) - var, expectBias2, 0.25 * expectBias2);
+    EXPECT_NEAR(mapMean(seedVarianceMap(a, b, truth)), var, 1e-12);
+    // Unbiased and noise-free renders: nothing either way.
+    EXPECT_EQ(seedVariance(truth, truth, truth), 0.0);
+    // It is symmetric in the two renders, and (a - b)^2 / 2 per value: for a = 1.2, b = 0.8
+    // against 1 with eps 0, 0.08.
+    EXPECT_NEAR(seedVariance(a, b, truth), seedVariance(b, a, truth), 1e-12);
+    EXPECT_NEAR(seedVariance(constant(3, 2, 1.2f), constant(3, 2, 0.8f), constant(3, 2, 1.f), 0.f), 0.08, 1e-6);
+    EXPECT_THROW(seedVariance(a, constant(3, 2, 1.f), truth), Error);
 }
 
 TEST(Metrics, SmapeOfKnownPairs) {
@@ -253,6 +293,42 @@ TEST(CompareCommand, RegionsSplitARendersErrorAndNeedItsPlanes) {
     EXPECT_EQ(test::runWedge("compare " + dir + "/x.pfm " + dir + "/r.exr --regions", &out, &err), 2);
     EXPECT_NE(err.find("--regions"), std::string::npos) << err;
     EXPECT_NE(err.find("x.pfm"), std::string::npos) << err;
+}
+
+TEST(CompareCommand, VarianceFromASecondRenderSplitsTheError) {
+    // Monte Carlo is unbiased: with a second render of another seed, nearly all of its relMSE
+    // against a reference of 16x the samples is variance (the reference's own noise, about a
+    // sixteenth of it, and the estimates' scatter are the rest).
+    std::string dir = test::tempDir(), out, err;
+    const std::string common = "--method mc --spp 2 --resolution 48x48 --quiet ";
+    ASSERT_EQ(test::runWedge("render cornell " + common + "--seed 1 -o " + dir + "/a.exr", &out, &err), 0) << err;
+    ASSERT_EQ(test::runWedge("render cornell " + common + "--seed 2 -o " + dir + "/b.exr", &out, &err), 0) << err;
+    ASSERT_EQ(test::runWedge("render cornell --method mc --spp 32 --resolution 48x48 --quiet --seed 9 -o " + dir + "/r.exr",
+                             &out, &err),
+              0)
+        << err;
+    ASSERT_EQ(test::runWedge("compare " + dir + "/a.exr " + dir + "/r.exr --regions --json --variance-from " + dir + "/b.exr",
+                             &out, &err),
+              0)
+        << err;
+    auto j = nlohmann::json::parse(out);
+    const double relmse = j["relmse"].get<double>(), variance = j["variance"].get<double>();
+    EXPECT_GT(variance, 0.75 * relmse);
+    EXPECT_LT(variance, 1.1 * relmse);
+    EXPECT_NEAR(j["bias2_and_reference_noise"].get<double>(), relmse - variance, 1e-12);
+    double weighted = 0;
+    for (const char* name : {"background", "mixed", "edge", "defocused", "interior"})
+        weighted += j["regions"][name]["pixels"].get<double>() * j["regions"][name]["variance"].get<double>();
+    EXPECT_NEAR(weighted, variance, 1e-6 * variance);
+    // The text form names both parts.
+    ASSERT_EQ(test::runWedge("compare " + dir + "/a.exr " + dir + "/r.exr --variance-from " + dir + "/b.exr", &out, &err), 0);
+    EXPECT_NE(out.find("variance"), std::string::npos) << out;
+    EXPECT_NE(out.find("squared bias"), std::string::npos) << out;
+    // A second render of another size is bad input that names it.
+    io::writePfm(dir + "/small.pfm", constant(4, 4, 1.f));
+    EXPECT_EQ(test::runWedge("compare " + dir + "/a.exr " + dir + "/r.exr --variance-from " + dir + "/small.pfm", &out, &err), 2);
+    EXPECT_NE(err.find("small.pfm"), std::string::npos) << err;
+    EXPECT_NE(err.find("--variance-from"), std::string::npos) << err;
 }
 
 TEST(CompareCommand, BadInputExitsWithTwo) {

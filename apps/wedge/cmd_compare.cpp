@@ -1,10 +1,12 @@
-// wedge compare TEST REF [--json] [--heatmap OUT.png] [--regions]: relMSE, SMAPE, PSNR and SSIM
-// of a rendering against a reference (metrics/metrics.h), a heat map of the per-pixel relative
-// squared error on a log scale, and where that error sits (metrics::regionErrors).
+// wedge compare TEST REF [--json] [--heatmap OUT.png] [--regions] [--variance-from OTHER]: relMSE,
+// SMAPE, PSNR and SSIM of a rendering against a reference (metrics/metrics.h), a heat map of the
+// per-pixel relative squared error on a log scale, where that error sits (metrics::regionErrors),
+// and how much of it is variance (metrics::seedVariance, from a second render with another seed).
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <memory>
+#include <optional>
 #include <nlohmann/json.hpp>
 
 #include "apps/wedge/commands.h"
@@ -17,7 +19,7 @@ namespace wedge::app {
 namespace {
 
 struct CompareArgs {
-    std::string test, reference, heatmap;
+    std::string test, reference, heatmap, varianceFrom;
     bool json = false, regions = false;
 };
 
@@ -41,13 +43,25 @@ void runCompare(const CompareArgs& a) {
         throw Error(a.test, "image size mismatch: " + std::to_string(test.width()) + "x" + std::to_string(test.height()) +
                                 " against " + std::to_string(reference.width()) + "x" +
                                 std::to_string(reference.height()) + " in " + a.reference);
+    // The variance part of TEST's error, from a render made alike with another seed.
+    std::optional<Image1f> variance;
+    if (!a.varianceFrom.empty()) {
+        Image3f other = io::readColor(a.varianceFrom);
+        if (!other.sameSize(test))
+            throw Error(a.varianceFrom, "--variance-from: image size " + std::to_string(other.width()) + "x" +
+                                            std::to_string(other.height()) + " differs from " + a.test + "'s " +
+                                            std::to_string(test.width()) + "x" + std::to_string(test.height()));
+        variance = metrics::seedVarianceMap(test, other, reference);
+    }
+    const double varianceMean = variance ? metrics::mapMean(*variance) : 0.0;
     std::vector<metrics::RegionError> regions;
     if (a.regions) {
         if (io::extension(a.test) != ".exr")
             throw Error(a.test, "--regions needs an EXR written by `wedge render -o x.exr` (its coverage and object planes)");
         const io::ExrImage exr = io::readExr(a.test);
         regions = metrics::regionErrors(test, reference, plane(exr, a.test, "object"), plane(exr, a.test, "coverage"),
-                                        plane(exr, a.test, "slope.defocus"));
+                                        plane(exr, a.test, "slope.defocus"), 2, metrics::kRelMseEpsilon,
+                                        variance ? &*variance : nullptr);
     }
     metrics::Metrics m = metrics::compare(test, reference);
     if (!a.heatmap.empty())
@@ -62,9 +76,16 @@ void runCompare(const CompareArgs& a) {
         j["smape"] = m.smape;
         j["psnr"] = std::isfinite(m.psnr) ? nlohmann::json(m.psnr) : nlohmann::json(nullptr);  // null: identical
         j["ssim"] = m.ssim;
+        if (variance) {
+            j["variance"] = varianceMean;
+            j["bias2_and_reference_noise"] = m.relMse - varianceMean;
+        }
         if (a.regions) {
             nlohmann::json r = nlohmann::json::object();
-            for (const auto& c : regions) r[c.name] = {{"pixels", c.pixels}, {"share", c.share}, {"relmse", c.relMse}};
+            for (const auto& c : regions) {
+                r[c.name] = {{"pixels", c.pixels}, {"share", c.share}, {"relmse", c.relMse}};
+                if (variance) r[c.name]["variance"] = c.variance;
+            }
             j["regions"] = r;
         }
         std::printf("%s\n", j.dump(2).c_str());
@@ -73,10 +94,19 @@ void runCompare(const CompareArgs& a) {
         std::printf("SMAPE  %.6g\n", m.smape);
         std::printf("PSNR   %.3f dB  (tone-mapped)\n", m.psnr);
         std::printf("SSIM   %.5f  (tone-mapped)\n", m.ssim);
+        if (variance) {
+            std::printf("variance %.6g  (half the relative squared difference from %s)\n", varianceMean,
+                        a.varianceFrom.c_str());
+            std::printf("rest     %.6g  (relMSE - variance: squared bias + the reference's own noise)\n",
+                        m.relMse - varianceMean);
+        }
         if (a.regions) {
-            std::printf("%-11s %8s %8s %10s\n", "region", "pixels", "error", "relMSE");
-            for (const auto& c : regions)
-                std::printf("%-11s %7.1f%% %7.1f%% %10.4g\n", c.name.c_str(), 100 * c.pixels, 100 * c.share, c.relMse);
+            std::printf("%-11s %8s %8s %10s%s\n", "region", "pixels", "error", "relMSE", variance ? "   variance" : "");
+            for (const auto& c : regions) {
+                std::printf("%-11s %7.1f%% %7.1f%% %10.4g", c.name.c_str(), 100 * c.pixels, 100 * c.share, c.relMse);
+                if (variance) std::printf(" %10.4g", c.variance);
+                std::printf("\n");
+            }
         }
     }
 }
@@ -92,6 +122,9 @@ void registerCompare(CLI::App& app) {
     cmd->add_flag("--regions", args->regions,
                   "Split relMSE over pixel classes of TEST's own planes (an EXR from wedge render): background, "
                   "mixed surfaces, edge (within 2 px), defocused, interior");
+    cmd->add_option("--variance-from", args->varianceFrom,
+                    "A render made like TEST but with another --seed: splits TEST's relMSE into variance and the "
+                    "rest (squared bias + the reference's own noise)");
     cmd->add_option("--heatmap", args->heatmap, "Write a heat map of log10 relative squared error (10^-4..1) as PNG");
     cmd->callback([args] { runCompare(*args); });
 }

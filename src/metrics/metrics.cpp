@@ -109,7 +109,8 @@ double referenceNoise(const Image3f& halfA, int nA, const Image3f& halfB, int nB
 }
 
 std::vector<RegionError> regionErrors(const Image3f& test, const Image3f& reference, const Image1f& object,
-                                      const Image1f& coverage, const Image1f& defocus, int edgeRadius, float eps) {
+                                      const Image1f& coverage, const Image1f& defocus, int edgeRadius, float eps,
+                                      const Image1f* variance) {
     const int W = test.width(), H = test.height();
     const Image1f e = relativeErrorMap(test, reference, eps);
     std::vector<RegionError> r = {{"background"}, {"mixed"}, {"edge"}, {"defocused"}, {"interior"}};
@@ -134,11 +135,13 @@ std::vector<RegionError> regionErrors(const Image3f& test, const Image3f& refere
             }
             r[k].pixels += 1;
             r[k].share += e[i];
+            if (variance) r[k].variance += (*variance)[i];
             total += e[i];
         }
     const double n = double(W) * double(H);
     for (auto& c : r) {
         c.relMse = c.pixels > 0 ? c.share / c.pixels : 0.0;
+        c.variance = c.pixels > 0 ? c.variance / c.pixels : 0.0;
         c.share = total > 0 ? c.share / total : 0.0;
         c.pixels = n > 0 ? c.pixels / n : 0.0;
     }
@@ -214,6 +217,31 @@ Image1f relativeErrorMap(const Image3f& test, const Image3f& reference, float ep
         out[i] = float(s / 3.0);
     }
     return out;
+}
+
+Image1f seedVarianceMap(const Image3f& a, const Image3f& b, const Image3f& reference, float eps) {
+    checkSameSize(a, reference);
+    checkSameSize(b, reference);
+    Image1f out(a.width(), a.height());
+    for (size_t i = 0; i < a.size(); ++i) {
+        double s = 0;
+        for (int c = 0; c < 3; ++c) {
+            double d = double(a[i][c]) - double(b[i][c]), r = reference[i][c];
+            s += 0.5 * d * d / (r * r + eps);
+        }
+        out[i] = float(s / 3.0);
+    }
+    return out;
+}
+
+double mapMean(const Image1f& map) {
+    double sum = 0;
+    for (size_t i = 0; i < map.size(); ++i) sum += map[i];
+    return map.size() ? sum / double(map.size()) : 0.0;
+}
+
+double seedVariance(const Image3f& a, const Image3f& b, const Image3f& reference, float eps) {
+    return mapMean(seedVarianceMap(a, b, reference, eps));
 }
 
 Image1f log10Map(const Image1f& values, float lo) {

@@ -40,6 +40,16 @@ Image1f ssimMap(const Image1f& x, const Image1f& y);
 /// Per-pixel relative squared error (x - r)^2 / (r^2 + eps), averaged over the channels; its
 /// mean is relMse().
 Image1f relativeErrorMap(const Image3f& test, const Image3f& reference, float eps = kRelMseEpsilon);
+/// Half the relative squared difference of two renders made alike but for independent seeds,
+/// (a - b)^2 / (2 (r^2 + eps)) averaged over the channels, per pixel. E[(a - b)^2] = 2 Var a, so
+/// its mean estimates the variance part of a's relMSE against r; the rest of that relMSE is the
+/// squared bias plus the reference's own noise (referenceNoise):
+///   E[relMSE(a, r)] = bias^2 + variance + reference noise   (all in relMSE units).
+Image1f seedVarianceMap(const Image3f& a, const Image3f& b, const Image3f& reference, float eps = kRelMseEpsilon);
+/// The mean of a per-pixel map (an error or variance map's relMSE-style total).
+double mapMean(const Image1f& map);
+/// The mean of seedVarianceMap().
+double seedVariance(const Image3f& a, const Image3f& b, const Image3f& reference, float eps = kRelMseEpsilon);
 /// log10 of an error map, floored at 10^lo (for heat maps over [lo, hi] decades).
 Image1f log10Map(const Image1f& values, float lo);
 
@@ -57,16 +67,18 @@ Image3f combineHalves(const Image3f& halfA, int nA, const Image3f& halfB, int nB
 /// (`wedge render -o x.exr` writes them): background (object < 0), mixed (coverage < 1: the
 /// samples saw more than one surface, or a surface and the background), edge (within
 /// `edgeRadius` pixels of a mixed pixel or of a pixel on another object), defocused (slope.defocus
-/// above one pixel per lens radius) and interior (the rest).
+/// above one pixel per lens radius) and interior (the rest). With `variance` (seedVarianceMap of
+/// the test render and one with another seed), each class also gets its variance part.
 struct RegionError {
     std::string name;
-    double pixels = 0;  // fraction of the image's pixels
-    double share = 0;   // fraction of the summed relative squared error
-    double relMse = 0;  // mean over the class's pixels
+    double pixels = 0;    // fraction of the image's pixels
+    double share = 0;     // fraction of the summed relative squared error
+    double relMse = 0;    // mean over the class's pixels
+    double variance = 0;  // mean of `variance` over the class's pixels (0 without it)
 };
 std::vector<RegionError> regionErrors(const Image3f& test, const Image3f& reference, const Image1f& object,
                                       const Image1f& coverage, const Image1f& defocus, int edgeRadius = 2,
-                                      float eps = kRelMseEpsilon);
+                                      float eps = kRelMseEpsilon, const Image1f* variance = nullptr);
 
 struct Metrics {
     double relMse = 0, smape = 0, psnr = 0, ssim = 0;

@@ -136,6 +136,10 @@ private:
     void loadOrRenderReference();
     /// relMSE net of the reference's own noise: what a noise-free reference would measure.
     double netRelMse(const ExperimentProbe& p) const { return p.metrics.relMse - m_result.referenceNoise; }
+    /// The squared bias of a base row: its net relMSE minus its variance.
+    double bias2(const ExperimentRow& r) const { return netRelMse(r.probe) - r.variance; }
+    /// The variance part of a base row's relMSE: the method rendered again with another seed.
+    double measureVariance(const std::string& method, const ExperimentProbe& p);
     /// Renders `method` at `spp` (memoised per method); nullopt when the method is not available.
     const ExperimentProbe* evaluate(const std::string& method, int spp);
     void searchEqualQuality(const std::string& method, double target);
@@ -244,6 +248,18 @@ const ExperimentProbe* Experiment::evaluate(const std::string& method, int spp) 
     return &memo.emplace(spp, std::move(p)).first->second;
 }
 
+double Experiment::measureVariance(const std::string& method, const ExperimentProbe& p) {
+    RenderOptions o = m_options.base;
+    o.method = method;
+    o.spp = p.spp;
+    o.seed = hashCombine(m_result.seed, 0x76617232U);  // independent of the base render's samples
+    o.quiet = true;
+    const double v = metrics::seedVariance(p.color, render(m_scene, o).color, m_reference);
+    say(method + " " + std::to_string(p.spp) + " spp with another seed: variance " + format("%.4g", v) +
+        ", squared bias " + format("%.4g", netRelMse(p) - v));
+    return v;
+}
+
 void Experiment::searchEqualQuality(const std::string& method, double target) {
     const ExperimentProbe& start = *evaluate(method, m_options.spp);
     std::vector<int> order;
@@ -330,6 +346,7 @@ ExperimentResult Experiment::run() {
         row.method = m;
         row.setting = "base";
         row.probe = *p;
+        row.variance = measureVariance(m, *p);
         m_result.rows.push_back(std::move(row));
     }
     if (available.empty()) throw Error("experiment", "none of the requested methods is available");
@@ -471,6 +488,10 @@ void Experiment::writeResultsJson() const {
         j["reference_noise_relmse"] = m_result.referenceNoise;
         j["relmse_net"] = netRelMse(row.probe);
         j["efficiency_net"] = row.netEfficiency;
+        if (row.variance >= 0) {
+            j["variance_relmse"] = row.variance;
+            j["bias2_relmse"] = bias2(row);
+        }
         j["overhead"] = overhead(row.probe.seconds);
         j["scene"] = m_result.scene;
         j["resolution"] = {m_result.width, m_result.height};
@@ -506,10 +527,10 @@ std::string Experiment::markdownTable() const {
     const ExperimentRow* mcBase = find("mc", "base");
     if (!m_options.commandLine.empty()) os << "`" << m_options.commandLine << "`\n\n";
     os << "| " << m_result.scene << " " << m_result.width << "x" << m_result.height
-       << " | spp | sampling | prefilter | filter | overhead | total | relMSE | net relMSE | PSNR | SSIM | efficiency | net efficiency |";
+       << " | spp | sampling | prefilter | filter | overhead | total | relMSE | net relMSE | variance | bias² | PSNR | SSIM | efficiency | net efficiency |";
     if (m_options.equalQuality) os << " EQ spp | EQ total | " << m_result.anchor << " speedup |";
     if (m_options.equalTime) os << " ET spp | ET relMSE |";
-    os << "\n|---|---|---|---|---|---|---|---|---|---|---|---|---|";
+    os << "\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|";
     if (m_options.equalQuality) os << "---|---|---|";
     if (m_options.equalTime) os << "---|---|";
     os << "\n";
@@ -519,8 +540,8 @@ std::string Experiment::markdownTable() const {
         os << "| " << r.method << " | " << format("%.1f", p.sppAverage) << " | " << seconds(p.seconds.get("sampling"))
            << " | " << seconds(p.seconds.get("prefilter")) << " | " << seconds(p.seconds.get("filter")) << " | "
            << format("%.1f%%", 100 * overhead(p.seconds)) << " | " << seconds(p.seconds.get("total")) << " | "
-           << format("%.4g", p.metrics.relMse) << " | " << format("%.4g", netRelMse(p))
-           << " | " << format("%.2f", p.metrics.psnr) << " | " << format("%.4f", p.metrics.ssim) << " | ";
+           << format("%.4g", p.metrics.relMse) << " | " << format("%.4g", netRelMse(p)) << " | "
+           << format("%.4g", r.variance) << " | " << format("%.4g", bias2(r)) << " | " << format("%.2f", p.metrics.psnr) << " | " << format("%.4f", p.metrics.ssim) << " | ";
         if (mcBase && mcBase->efficiency > 0) os << format("%.2fx mc", r.efficiency / mcBase->efficiency);
         else os << format("%.4g", r.efficiency);
         os << " | ";
@@ -548,6 +569,8 @@ std::string Experiment::markdownTable() const {
     os << "\nReference: mc " << m_result.referenceSpp << " spp in two independent halves; its own noise, estimated from "
        << "them, is relMSE " << format("%.4g", m_result.referenceNoise)
        << " (part of every relMSE here; net relMSE = relMSE minus it, what a noise-free reference would measure). "
+       << "Variance: half the relative squared difference from a render with another seed; bias² = net relMSE - "
+          "variance. "
        << ThreadLimit::current() << " threads"
        << (m_options.repeat > 1 ? ", times the fastest of " + std::to_string(m_options.repeat) + " renders" : "")
        << ". relMSE with eps 0.01, no 0.5 factor; PSNR/SSIM on tone-mapped images. "
@@ -649,19 +672,21 @@ void Experiment::writeHtml() const {
           << m_cap << " spp. Speedup = EQ total / " << htmlEscape(m_result.anchor) << " total.</p>\n";
 
     h << "<h2>Quality</h2>\n<table><tr><th>method</th><th>setting</th><th>spp</th><th>total</th><th>relMSE</th>"
-         "<th>net relMSE</th><th>SMAPE</th><th>PSNR (dB)</th><th>SSIM</th><th>efficiency 1/(relMSE&middot;s)</th>"
+         "<th>net relMSE</th><th>variance</th><th>bias&sup2;</th><th>SMAPE</th><th>PSNR (dB)</th><th>SSIM</th><th>efficiency 1/(relMSE&middot;s)</th>"
          "<th>net efficiency</th></tr>\n";
     for (const auto& r : m_result.rows) {
         const auto& m = r.probe.metrics;
         std::string mark = r.setting != "base" && !r.reached ? " (bound)" : "";
         h << "<tr>" << td(htmlEscape(r.method)) << td(settingLabel(r.setting) + mark) << td(format("%.1f", r.probe.sppAverage))
           << td(seconds(r.probe.seconds.get("total"))) << td(format("%.4g", m.relMse))
-          << td(format("%.4g", netRelMse(r.probe))) << td(format("%.4f", m.smape))
+          << td(format("%.4g", netRelMse(r.probe))) << td(r.variance >= 0 ? format("%.4g", r.variance) : "-")
+          << td(r.variance >= 0 ? format("%.4g", bias2(r)) : "-") << td(format("%.4f", m.smape))
           << td(format("%.2f", m.psnr)) << td(format("%.4f", m.ssim)) << td(format("%.4g", r.efficiency))
           << td(r.netEfficiency > 0 ? format("%.4g", r.netEfficiency) : "-") << "</tr>\n";
     }
     h << "</table>\n<p>relMSE = mean (x&minus;r)&sup2;/(r&sup2;+0.01), no 0.5 factor, linear radiance; net relMSE = "
-         "relMSE &minus; the reference's own noise. PSNR and SSIM "
+         "relMSE &minus; the reference's own noise; variance = half the relative squared difference from a render "
+         "with another seed (base rows), bias&sup2; = net relMSE &minus; variance. PSNR and SSIM "
          "(11&times;11 Gaussian, &sigma; 1.5) on tone-mapped images (clamp, sRGB).</p>\n";
 
     // Images side by side, with insets and heat maps.

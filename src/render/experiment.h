@@ -17,6 +17,11 @@
 // relMSE measured against it carries that much on top of the method's error against the truth,
 // which pulls all ratios towards 1. Rows report the net relMSE (relMSE - noise) and the net
 // efficiency beside the measured ones.
+//
+// Each base row is rendered once more with another seed (not timed): half the two renders'
+// relative squared difference is the variance part of the row's relMSE (metrics::seedVariance),
+// and the net relMSE minus it the squared bias, so a row says whether a method errs by noise
+// (too few samples, too narrow a filter) or by bias (too wide a filter).
 #pragma once
 
 #include <algorithm>
@@ -66,6 +71,9 @@ struct ExperimentRow {
     ExperimentProbe probe;
     double efficiency = 0;     // 1 / (relMSE * total seconds)
     double netEfficiency = 0;  // 1 / ((relMSE - reference noise) * total seconds); 0 if not positive
+    // Base rows: the variance part of relMSE (from a render with another seed); the squared bias
+    // is the net relMSE minus it. Negative: not measured (the other settings' rows).
+    double variance = -1;
     // Searches: the target (relMSE or seconds), whether it was reached within the cap, and every
     // render the search made, in order.
     double target = 0;
