@@ -140,6 +140,15 @@ private:
     double bias2(const ExperimentRow& r) const { return netRelMse(r.probe) - r.variance; }
     /// The variance part of a base row's relMSE: the method rendered again with another seed.
     double measureVariance(const std::string& method, const ExperimentProbe& p);
+    /// The options of one render: the base options with this method, spp and seed.
+    RenderOptions renderOptions(const std::string& method, int spp, uint32_t seed, bool quiet) const {
+        RenderOptions o = m_options.base;
+        o.method = method;
+        o.spp = spp;
+        o.seed = seed;
+        o.quiet = quiet;
+        return o;
+    }
     /// Renders `method` at `spp` (memoised per method); nullopt when the method is not available.
     const ExperimentProbe* evaluate(const std::string& method, int spp);
     void searchEqualQuality(const std::string& method, double target);
@@ -190,11 +199,7 @@ void Experiment::loadOrRenderReference() {
     // reference's own noise.
     const int nA = m_result.referenceSpp / 2, nB = m_result.referenceSpp - nA;
     say("rendering the reference: mc, " + std::to_string(m_result.referenceSpp) + " spp in two independent halves");
-    RenderOptions o = m_options.base;
-    o.method = "mc";
-    o.quiet = m_options.quiet;
-    o.spp = nA;
-    o.seed = m_result.referenceSeed;
+    RenderOptions o = renderOptions("mc", nA, m_result.referenceSeed, m_options.quiet);
     RenderResult a = render(m_scene, o);
     o.spp = nB;
     o.seed = hashCombine(m_result.referenceSeed, 0x68616c66U);
@@ -217,11 +222,7 @@ void Experiment::loadOrRenderReference() {
 const ExperimentProbe* Experiment::evaluate(const std::string& method, int spp) {
     auto& memo = m_memo[method];
     if (auto it = memo.find(spp); it != memo.end()) return &it->second;
-    RenderOptions o = m_options.base;
-    o.method = method;
-    o.spp = spp;
-    o.seed = m_result.seed;
-    o.quiet = m_options.quiet;
+    RenderOptions o = renderOptions(method, spp, m_result.seed, m_options.quiet);
     RenderResult r;
     try {
         r = render(m_scene, o);
@@ -249,15 +250,9 @@ const ExperimentProbe* Experiment::evaluate(const std::string& method, int spp) 
 }
 
 double Experiment::measureVariance(const std::string& method, const ExperimentProbe& p) {
-    RenderOptions o = m_options.base;
-    o.method = method;
-    o.spp = p.spp;
-    o.seed = hashCombine(m_result.seed, 0x76617232U);  // independent of the base render's samples
-    o.quiet = true;
-    const double v = metrics::seedVariance(p.color, render(m_scene, o).color, m_reference);
-    say(method + " " + std::to_string(p.spp) + " spp with another seed: variance " + format("%.4g", v) +
-        ", squared bias " + format("%.4g", netRelMse(p) - v));
-    return v;
+    // Another seed, independent of the base render's samples.
+    const RenderOptions o = renderOptions(method, p.spp, hashCombine(m_result.seed, 0x76617232U), true);
+    return metrics::seedVariance(p.color, render(m_scene, o).color, m_reference);
 }
 
 void Experiment::searchEqualQuality(const std::string& method, double target) {
@@ -324,11 +319,7 @@ ExperimentResult Experiment::run() {
 
     // Warm-up: the first render of a process pays for starting the worker threads.
     {
-        RenderOptions o = m_options.base;
-        o.method = "mc";
-        o.spp = 1;
-        o.quiet = true;
-        (void)render(m_scene, o);
+        (void)render(m_scene, renderOptions("mc", 1, m_result.seed, true));
     }
     loadOrRenderReference();
 
@@ -347,6 +338,8 @@ ExperimentResult Experiment::run() {
         row.setting = "base";
         row.probe = *p;
         row.variance = measureVariance(m, *p);
+        say(m + " " + std::to_string(p->spp) + " spp with another seed: variance " + format("%.4g", row.variance) +
+            ", squared bias " + format("%.4g", bias2(row)));
         m_result.rows.push_back(std::move(row));
     }
     if (available.empty()) throw Error("experiment", "none of the requested methods is available");
@@ -380,11 +373,7 @@ ExperimentResult Experiment::run() {
     for (auto& row : m_result.rows) {
         ExperimentProbe& p = m_memo[row.method].at(row.probe.spp);
         if (!p.retimed) {
-            RenderOptions o = m_options.base;
-            o.method = row.method;
-            o.spp = p.spp;
-            o.seed = m_result.seed;
-            o.quiet = true;
+            const RenderOptions o = renderOptions(row.method, p.spp, m_result.seed, true);
             for (int k = 0; k < m_options.repeat; ++k) {
                 StageTimes t = render(m_scene, o).seconds;
                 if (t.get("total") < p.seconds.get("total")) p.seconds = t;
