@@ -158,6 +158,9 @@ TEST(Metrics, SeedVarianceSplitsNoiseFromBias) {
     EXPECT_NEAR(var, expectVar, 0.05 * expectVar);
     EXPECT_NEAR(relMse(a, truth) - var, expectBias2, 0.25 * expectBias2);
     EXPECT_NEAR(mapMean(seedVarianceMap(a, b, truth)), var, 1e-12);
+    // The product of the two errors has the squared bias as its mean, without the variance.
+    EXPECT_NEAR(mapMean(seedBiasMap(a, b, truth)), expectBias2, 0.25 * expectBias2);
+    EXPECT_NEAR(mapMean(seedBiasMap(truth, truth, constant(W, H, 1.1f))), 0.01 / 1.22, 1e-6);
     // Unbiased and noise-free renders: nothing either way.
     EXPECT_EQ(seedVariance(truth, truth, truth), 0.0);
     // It is symmetric in the two renders, and (a - b)^2 / 2 per value: for a = 1.2, b = 0.8
@@ -324,6 +327,19 @@ TEST(CompareCommand, VarianceFromASecondRenderSplitsTheError) {
     ASSERT_EQ(test::runWedge("compare " + dir + "/a.exr " + dir + "/r.exr --variance-from " + dir + "/b.exr", &out, &err), 0);
     EXPECT_NE(out.find("variance"), std::string::npos) << out;
     EXPECT_NE(out.find("squared bias"), std::string::npos) << out;
+    // The squared bias where it sits, on the error heat map's scale.
+    ASSERT_EQ(test::runWedge("compare " + dir + "/a.exr " + dir + "/r.exr --variance-from " + dir + "/b.exr --bias-heatmap " +
+                                 dir + "/bias.png",
+                             &out, &err),
+              0)
+        << err;
+    Image3f bias = io::readPng(dir + "/bias.png");
+    EXPECT_EQ(bias.width(), 48);
+    EXPECT_EQ(bias.height(), 48);
+    // It needs the second render, and says so before writing anything.
+    EXPECT_EQ(test::runWedge("compare " + dir + "/a.exr " + dir + "/r.exr --bias-heatmap " + dir + "/bias2.png", &out, &err), 2);
+    EXPECT_NE(err.find("--variance-from"), std::string::npos) << err;
+    EXPECT_FALSE(std::filesystem::exists(dir + "/bias2.png"));
     // A second render of another size is bad input that names it.
     io::writePfm(dir + "/small.pfm", constant(4, 4, 1.f));
     EXPECT_EQ(test::runWedge("compare " + dir + "/a.exr " + dir + "/r.exr --variance-from " + dir + "/small.pfm", &out, &err), 2);

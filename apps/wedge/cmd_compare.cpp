@@ -1,7 +1,8 @@
-// wedge compare TEST REF [--json] [--heatmap OUT.png] [--regions] [--variance-from OTHER]: relMSE,
-// SMAPE, PSNR and SSIM of a rendering against a reference (metrics/metrics.h), a heat map of the
-// per-pixel relative squared error on a log scale, where that error sits (metrics::regionErrors),
-// and how much of it is variance (metrics::seedVariance, from a second render with another seed).
+// wedge compare TEST REF [--json] [--heatmap OUT.png] [--regions] [--variance-from OTHER
+// [--bias-heatmap OUT.png]]: relMSE, SMAPE, PSNR and SSIM of a rendering against a reference
+// (metrics/metrics.h), a heat map of the per-pixel relative squared error on a log scale, where
+// that error sits (metrics::regionErrors), how much of it is variance (metrics::seedVariance, from
+// a second render with another seed) and where the squared bias is (metrics::seedBiasMap).
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -19,7 +20,7 @@ namespace wedge::app {
 namespace {
 
 struct CompareArgs {
-    std::string test, reference, heatmap, varianceFrom;
+    std::string test, reference, heatmap, varianceFrom, biasHeatmap;
     bool json = false, regions = false;
 };
 
@@ -35,23 +36,31 @@ Image1f plane(const io::ExrImage& exr, const std::string& path, const std::strin
 
 // Heat maps show log10 relative squared error from 10^-4 (dark) to 10^0 (yellow).
 constexpr float kHeatLo = -4.f, kHeatHi = 0.f;
+// Bias heat maps: the squared bias is a part of the error, so one decade lower.
+constexpr float kBiasHeatLo = -5.f, kBiasHeatHi = -1.f;
 
 void runCompare(const CompareArgs& a) {
     if (!a.heatmap.empty()) io::checkOutputPath(a.heatmap, {".png"});
+    if (!a.biasHeatmap.empty()) {
+        if (a.varianceFrom.empty())
+            throw Error("--bias-heatmap", "needs --variance-from OTHER (a second render with another seed)");
+        io::checkOutputPath(a.biasHeatmap, {".png"});
+    }
     Image3f test = io::readColor(a.test), reference = io::readColor(a.reference);
     if (!test.sameSize(reference))
         throw Error(a.test, "image size mismatch: " + std::to_string(test.width()) + "x" + std::to_string(test.height()) +
                                 " against " + std::to_string(reference.width()) + "x" +
                                 std::to_string(reference.height()) + " in " + a.reference);
     // The variance part of TEST's error, from a render made alike with another seed.
+    std::optional<Image3f> other;
     std::optional<Image1f> variance;
     if (!a.varianceFrom.empty()) {
-        Image3f other = io::readColor(a.varianceFrom);
-        if (!other.sameSize(test))
-            throw Error(a.varianceFrom, "--variance-from: image size " + std::to_string(other.width()) + "x" +
-                                            std::to_string(other.height()) + " differs from " + a.test + "'s " +
+        other = io::readColor(a.varianceFrom);
+        if (!other->sameSize(test))
+            throw Error(a.varianceFrom, "--variance-from: image size " + std::to_string(other->width()) + "x" +
+                                            std::to_string(other->height()) + " differs from " + a.test + "'s " +
                                             std::to_string(test.width()) + "x" + std::to_string(test.height()));
-        variance = metrics::seedVarianceMap(test, other, reference);
+        variance = metrics::seedVarianceMap(test, *other, reference);
     }
     const double varianceMean = variance ? metrics::mapMean(*variance) : 0.0;
     std::vector<metrics::RegionError> regions;
@@ -67,6 +76,10 @@ void runCompare(const CompareArgs& a) {
     if (!a.heatmap.empty())
         io::writePngHeat(a.heatmap, metrics::log10Map(metrics::relativeErrorMap(test, reference), kHeatLo), kHeatLo,
                          kHeatHi);
+    if (!a.biasHeatmap.empty())
+        io::writePngHeat(a.biasHeatmap,
+                         metrics::log10Map(metrics::seedBiasMap(test, *other, reference), kBiasHeatLo),
+                         kBiasHeatLo, kBiasHeatHi);
     if (a.json) {
         nlohmann::json j;
         j["test"] = a.test;
@@ -126,6 +139,9 @@ void registerCompare(CLI::App& app) {
                     "A render made like TEST but with another --seed: splits TEST's relMSE into variance and the "
                     "rest (squared bias + the reference's own noise)");
     cmd->add_option("--heatmap", args->heatmap, "Write a heat map of log10 relative squared error (10^-4..1) as PNG");
+    cmd->add_option("--bias-heatmap", args->biasHeatmap,
+                    "With --variance-from: write a heat map of the squared bias, (TEST - REF)(OTHER - REF) / (REF^2 + "
+                    "0.01), log10 from 10^-5 to 10^-1, as PNG");
     cmd->callback([args] { runCompare(*args); });
 }
 

@@ -234,6 +234,21 @@ Image1f seedVarianceMap(const Image3f& a, const Image3f& b, const Image3f& refer
     return out;
 }
 
+Image1f seedBiasMap(const Image3f& a, const Image3f& b, const Image3f& reference, float eps) {
+    checkSameSize(a, reference);
+    checkSameSize(b, reference);
+    Image1f out(a.width(), a.height());
+    for (size_t i = 0; i < a.size(); ++i) {
+        double s = 0;
+        for (int c = 0; c < 3; ++c) {
+            double r = reference[i][c];
+            s += (double(a[i][c]) - r) * (double(b[i][c]) - r) / (r * r + eps);
+        }
+        out[i] = float(s / 3.0);
+    }
+    return out;
+}
+
 double mapMean(const Image1f& map) {
     double sum = 0;
     for (size_t i = 0; i < map.size(); ++i) sum += map[i];

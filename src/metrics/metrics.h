@@ -46,6 +46,12 @@ Image1f relativeErrorMap(const Image3f& test, const Image3f& reference, float ep
 /// squared bias plus the reference's own noise (referenceNoise):
 ///   E[relMSE(a, r)] = bias^2 + variance + reference noise   (all in relMSE units).
 Image1f seedVarianceMap(const Image3f& a, const Image3f& b, const Image3f& reference, float eps = kRelMseEpsilon);
+/// Per pixel, (a - r)(b - r) / (r^2 + eps) averaged over the channels, for the same two renders:
+/// since their errors are independent, E[(a - r)(b - r)] = bias^2 + Var r, so this is the squared
+/// bias where it sits (plus the reference's own noise), without the variance that (a - r)^2 holds.
+/// Its mean estimates what relMSE - seedVariance does. Noisy per pixel (negative where the two
+/// errors differ in sign); a heat map of it shows where a filter's bias is.
+Image1f seedBiasMap(const Image3f& a, const Image3f& b, const Image3f& reference, float eps = kRelMseEpsilon);
 /// The mean of a per-pixel map (an error or variance map's relMSE-style total).
 double mapMean(const Image1f& map);
 /// The mean of seedVarianceMap().
