@@ -96,6 +96,35 @@ TEST(AafFilter, KeepsEdgesAcrossNormalDiscontinuities) {
         for (int x = 0; x < 20; ++x) EXPECT_EQ(out(x, y).x, signal(x, y).x) << x;
 }
 
+TEST(AafFilter, MirrorsSurfaceCutsSoThatAGradientStaysUnbiased) {
+    // Object 0 for x < 20 carries a linear ramp; object 1 from x = 20 on. Near the silhouette a
+    // one-sided window averages the ramp's lower values, a symmetric one reproduces the ramp. The
+    // mixed pixel (x = 19, coverage 0.5) keeps its one-sided window.
+    const int W = 30, H = 6;
+    Plane pl(W, H);
+    Image3f signal(W, H);
+    for (int y = 0; y < H; ++y)
+        for (int x = 0; x < W; ++x) {
+            pl.fb.object(x, y) = x < 20 ? 0.f : 1.f;
+            signal(x, y) = Vec3f(x < 20 ? 0.02f * x : 5.f);
+            pl.fb.coverage(x, y) = x == 19 ? 0.5f : 1.f;
+        }
+    Image1f omega(W, H, 0.f);  // the widest window, 10 px
+    AafOptions o;
+    Image3f mirrored = aafFilter(signal, omega, pl.fb, pl.frames, o);
+    o.mirrorSurfaceCuts = false;
+    Image3f oneSided = aafFilter(signal, omega, pl.fb, pl.frames, o);
+    for (int y = 0; y < H; ++y) {
+        for (int x = 11; x < 19; ++x) {
+            EXPECT_NEAR(mirrored(x, y).x, 0.02f * x, 1e-5f) << x;
+            if (x >= 12) EXPECT_LT(oneSided(x, y).x, 0.02f * x - 0.005f) << x;  // biased low
+        }
+        EXPECT_EQ(mirrored(19, y).x, oneSided(19, y).x) << "a mixed pixel keeps its one-sided window";
+        EXPECT_LT(mirrored(19, y).x, 0.02f * 19 - 0.01f);
+        for (int x = 20; x < W; ++x) EXPECT_NEAR(mirrored(x, y).x, 5.f, 1e-5f);
+    }
+}
+
 TEST(AafFilter, SameResultOnOneAndTwoThreads) {
     Plane pl(40, 30);
     Image3f signal(40, 30);
@@ -316,6 +345,37 @@ TEST(MaafFilter, ConstantSignalStaysConstantAndNoNan) {
         ASSERT_TRUE(isFinite(out[i]));
         EXPECT_NEAR(out[i].x, 0.75f, 1e-4f);
     }
+}
+
+TEST(MaafFilter, MirrorsSurfaceCutsSoThatAGradientStaysUnbiased) {
+    // As AafFilter.MirrorsSurfaceCuts...: a ramp on object 0 (x < 20), object 1 beyond, the
+    // central component only (one sample per pixel at the light's centre).
+    const int W = 30, H = 6;
+    Plane pl(W, H);
+    MaafPixel params = uniformParams(1, false);
+    for (int k = 0; k < 2; ++k) params.axis[k].sx[0] = 0.4f;  // std 2.5 px: an 8-px window
+    Image<MaafPixel> stored(W, H, params);
+    MaafEffect pimg(stored);
+    MaafAccumulator acc(pimg, 1, 1);
+    for (int y = 0; y < H; ++y)
+        for (int x = 0; x < W; ++x) {
+            pl.fb.object(x, y) = x < 20 ? 0.f : 1.f;
+            float v = x < 20 ? 0.02f * x : 5.f, zero[2] = {0, 0};
+            acc.add(size_t(y) * W + x, &v, 1.f, zero, zero, params);
+        }
+    MaafOptions o;
+    o.pairs = 1;
+    const Image3f fallback(W, H, Vec3f(-1.f));
+    Image3f mirrored = acc.filter(pimg, pl.fb, pl.frames, fallback, o);
+    o.mirrorSurfaceCuts = false;
+    Image3f oneSided = acc.filter(pimg, pl.fb, pl.frames, fallback, o);
+    const int radius = int(std::ceil(3.f / params.axis[0].sx[0]));
+    ASSERT_GE(radius, 3);
+    for (int y = 0; y < H; ++y)
+        for (int x = std::max(radius, 20 - radius); x < 19; ++x) {
+            EXPECT_NEAR(mirrored(x, y).x, 0.02f * x, 1e-5f) << x;
+            if (x >= 15) EXPECT_LT(oneSided(x, y).x, 0.02f * x - 0.002f) << x;  // biased low
+        }
 }
 
 TEST(MaafAccumulator, CentralOnlyPixelsFromTheirSumsEqualTheirSamples) {

@@ -53,6 +53,9 @@ struct ViewGeometry {
 /// cos 20 degrees: two normals closer than this are one surface, for the pixel's surface slots
 /// (render/pixel_stats.h) and for every filter's neighbour test.
 constexpr float kSameSurfaceCos = 0.9396926f;
+/// A pixel whose primary surface covers at least this fraction of its samples saw one surface
+/// only (FrameBuffers::coverage); below it, a mixed pixel.
+constexpr float kFullCoverage = 0.999f;
 
 /// Per-pixel planes. A pixel's samples are split by surface (object, normal within 20 degrees,
 /// tangent plane): the G-buffer planes (albedo, normal, position, depth, object) and the

@@ -59,6 +59,8 @@ float aafRadiusPixels(float omega, float step, int maxRadius) {
 
 namespace {
 
+constexpr int kMaxRadius = 64;  // the window buffers' half-size (AafOptions::maxRadius is 10)
+
 /// One separable pass along `axis` (0: image x, 1: image y) with the centre pixel's bandwidth.
 void pass(const Image3f& src, const Image1f& srcWeight, Image3f& dst, Image1f& dstWeight, int axis, const Image1f& omega,
           const FrameBuffers& fb, const Image<AxisFrame>& frames, const AafOptions& o) {
@@ -76,31 +78,41 @@ void pass(const Image3f& src, const Image1f& srcWeight, Image3f& dst, Image1f& d
             // Unbounded bandwidth (no wedge): the widest filter the window allows.
             float omFloor = 1.f / (o.maxRadius * f.step[axis]);
             float omEff = std::max(om, omFloor);
-            int radius = int(std::min(float(o.maxRadius), 1.f / (omEff * f.step[axis])));
-            Vec3f P = fb.position[p], n = fb.normal[p];
-            float planeTol = o.planeDistance * fb.footprint[p];
-            Vec3f sum(0.f);
-            float wsum = 0;
+            int radius = int(std::min(float(std::min(o.maxRadius, kMaxRadius)), 1.f / (omEff * f.step[axis])));
+            // The window's weights (0: not used) and which neighbours another surface cut off.
+            float w[2 * kMaxRadius + 1];
+            bool cut[2 * kMaxRadius + 1];
+            const Vec3f P = fb.position[p];
             for (int k = -radius; k <= radius; ++k) {
+                w[k + radius] = 0;
+                cut[k + radius] = false;
                 int xx = axis == 0 ? x + k : x, yy = axis == 0 ? y : y + k;
                 if (xx < 0 || xx >= W || yy < 0 || yy >= H) continue;
                 size_t q = size_t(yy) * W + xx;
-                if (q != p) {
-                    if (!sameSurface(fb, p, q, o.normalCos)) continue;
-                    Vec3f dP = fb.position[q] - P;
-                    if (std::abs(dot(dP, n)) > planeTol) continue;
-                    float oq = std::max(omega[q], 1.f / (o.maxRadius * frames[q].step[axis]));
-                    if (oq > o.bandwidthRatio * omEff || omEff > o.bandwidthRatio * oq) continue;
-                    float a0 = dot(dP, f.axis[0]), a1 = dot(dP, f.axis[1]);
-                    float r2o2 = (a0 * a0 + a1 * a1) * omEff * omEff;
-                    if (r2o2 > 1.f) continue;  // cut at r Omega > 1 (NOTES)
-                    float w = std::exp(-3.f * r2o2) * srcWeight[q];
-                    sum += src[q] * w;
-                    wsum += w;
-                } else {
-                    sum += src[q] * srcWeight[q];
-                    wsum += srcWeight[q];
+                if (q == p) {
+                    w[k + radius] = srcWeight[q];
+                    continue;
                 }
+                if (!sameSurface(fb, p, q, o.normalCos) || !onTangentPlane(fb, p, q, o.planeDistance)) {
+                    cut[k + radius] = true;
+                    continue;
+                }
+                float oq = std::max(omega[q], 1.f / (o.maxRadius * frames[q].step[axis]));
+                if (oq > o.bandwidthRatio * omEff || omEff > o.bandwidthRatio * oq) continue;
+                Vec3f dP = fb.position[q] - P;
+                float a0 = dot(dP, f.axis[0]), a1 = dot(dP, f.axis[1]);
+                float r2o2 = (a0 * a0 + a1 * a1) * omEff * omEff;
+                if (r2o2 > 1.f) continue;  // cut at r Omega > 1 (NOTES)
+                w[k + radius] = std::exp(-3.f * r2o2) * srcWeight[q];
+            }
+            const bool mirror = o.mirrorSurfaceCuts && fb.coverage[p] >= kFullCoverage;
+            Vec3f sum(0.f);
+            float wsum = 0;
+            for (int k = -radius; k <= radius; ++k) {
+                if (w[k + radius] <= 0 || (mirror && cut[radius - k])) continue;
+                size_t q = axis == 0 ? p + k : size_t(y + k) * W + x;
+                sum += src[q] * w[k + radius];
+                wsum += w[k + radius];
             }
             // Carry the weight so that the second pass weighs the first pass's sums correctly.
             dst[p] = wsum > 0 ? sum / wsum : Vec3f(0.f);

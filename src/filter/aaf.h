@@ -9,7 +9,8 @@
 //   defocus  Omega_u = Omega_u^max / (min |s_u| d), Omega_u^max = 2/sigma_u, sigma_u = 1/3 (lens = Gaussian of A/3)
 //   combined Omega_x = min(1/d, Omega_s or Omega_i, Omega_u)         (NOTES: the widest of the widths)
 // Kernel exp(-3 r^2 Omega_x^2), cut at r Omega_x > 1, separable along the image axes
-// (report eq. 3.7), r in world space within the light plane (direct) or the tangent plane.
+// (report eq. 3.7), r in world space within the light plane (direct) or the tangent plane; a
+// window cut by another surface on one side is cut on the other too (AafOptions::mirrorSurfaceCuts).
 // Sampling rates: direct per NOTES (AAF 2012 code), indirect per report eq. 4.6, both with the
 // combined Omega_x; a lens rate of the same form as the shadow rate.
 #pragma once
@@ -29,6 +30,14 @@ struct AafOptions {
     float normalCos = kSameSurfaceCos;  // reject neighbours whose normals differ by 20 degrees or more
     float bandwidthRatio = 3.f;  // reject neighbours whose bandwidth differs by more than this factor
     float planeDistance = 2.f;   // reject neighbours farther than this many pixel sizes off the tangent plane
+    // A neighbour cut off by another surface (another object, a normal 20 degrees off, off the
+    // tangent plane) also removes its mirror image from the window, so that the window stays
+    // symmetric about the pixel: a one-sided window averages the surface's gradient towards the
+    // silhouette (a contact shadow, indirect light darkening into a corner) into bias. Pixels
+    // whose samples saw several surfaces keep one-sided windows: they need their primary surface's
+    // neighbours. Measured (512x512, relMSE against 1024-spp references): grids -16%, bunny -3%,
+    // sponza -1%, conference -1%, cornell and cornell-sphere +0.5%.
+    bool mirrorSurfaceCuts = true;
     float zMinPixels = 10.f;  // clamp of the bounce distance z_min, in pixel sizes (NOTES: scene-scale constant)
 };
 

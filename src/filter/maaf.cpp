@@ -345,27 +345,27 @@ int windowRadius(const MaafAxis& ax, float step, int maxRadius) {
     return std::clamp(int(std::ceil(3.f * stdPx)), 1, maxRadius);
 }
 
-/// Neighbour test shared by both passes; on success gives the signed offset a (output minus
+/// Neighbour test shared by both passes; on acceptance gives the signed offset a (output minus
 /// input, along `axis` of the output pixel's frame) and the in-plane distance r.
-bool neighbour(const FrameBuffers& fb, const MaafEffect& params, const AxisFrame& f, size_t p, size_t q, int axis,
-               const MaafOptions& o, float& a, float& r) {
-    if (q != p) {
-        if (!sameSurface(fb, p, q, o.normalCos)) return false;
-        float wp = params.centralSx(p, axis), wq = params.centralSx(q, axis);
-        if (wp > o.bandwidthRatio * wq || wq > o.bandwidthRatio * wp) return false;
-        Vec3f dP = fb.position[p] - fb.position[q];
-        if (std::abs(dot(dP, fb.normal[p])) > o.planeDistance * fb.footprint[p]) return false;
-        float a0 = dot(dP, f.axis[0]), a1 = dot(dP, f.axis[1]);
-        a = axis == 0 ? a0 : a1;
-        r = std::sqrt(a0 * a0 + a1 * a1);
-    } else {
-        a = r = 0;
-    }
-    return true;
+enum class Neighbour { Accepted, OtherSurface, Rejected };
+Neighbour neighbour(const FrameBuffers& fb, const MaafEffect& params, const AxisFrame& f, size_t p, size_t q, int axis,
+                    const MaafOptions& o, float& a, float& r) {
+    a = r = 0;
+    if (q == p) return Neighbour::Accepted;
+    if (!sameSurface(fb, p, q, o.normalCos) || !onTangentPlane(fb, p, q, o.planeDistance)) return Neighbour::OtherSurface;
+    float wp = params.centralSx(p, axis), wq = params.centralSx(q, axis);
+    if (wp > o.bandwidthRatio * wq || wq > o.bandwidthRatio * wp) return Neighbour::Rejected;
+    Vec3f dP = fb.position[p] - fb.position[q];
+    float a0 = dot(dP, f.axis[0]), a1 = dot(dP, f.axis[1]);
+    a = axis == 0 ? a0 : a1;
+    r = std::sqrt(a0 * a0 + a1 * a1);
+    return Neighbour::Accepted;
 }
 
 /// The neighbours of pixel (x, y) along image axis `axis` within the pixel's window:
-/// ok[k + radius] where neighbour() accepts the pixel at offset k, with its a and r.
+/// ok[k + radius] where neighbour() accepts the pixel at offset k, with its a and r. With
+/// MaafOptions::mirrorSurfaceCuts (and a pixel that saw one surface), a neighbour whose mirror
+/// image is another surface is left out too, so that the window stays symmetric (filter/aaf.h).
 struct Window {
     static constexpr int kMaxRadius = kMaafMaxWindowRadius;
     int radius;
@@ -376,11 +376,17 @@ struct Window {
            int axis, const MaafOptions& o) {
         radius = std::min(windowRadius(own, f.step[axis], o.maxRadius), kMaxRadius);
         const size_t p = size_t(y) * fb.width + x;
+        bool cut[2 * kMaxRadius + 1];
         for (int k = -radius; k <= radius; ++k) {
             int xx = axis == 0 ? x + k : x, yy = axis == 0 ? y : y + k;
-            ok[k + radius] = xx >= 0 && xx < fb.width && yy >= 0 && yy < fb.height &&
-                             neighbour(fb, params, f, p, size_t(yy) * fb.width + xx, axis, o, a[k + radius], r[k + radius]);
+            Neighbour n = Neighbour::Rejected;  // outside the image
+            if (xx >= 0 && xx < fb.width && yy >= 0 && yy < fb.height)
+                n = neighbour(fb, params, f, p, size_t(yy) * fb.width + xx, axis, o, a[k + radius], r[k + radius]);
+            ok[k + radius] = n == Neighbour::Accepted;
+            cut[k + radius] = n == Neighbour::OtherSurface;
         }
+        if (o.mirrorSurfaceCuts && fb.coverage[p] >= kFullCoverage)
+            for (int k = -radius; k <= radius; ++k) ok[k + radius] = ok[k + radius] && !cut[radius - k];
     }
 };
 

@@ -128,6 +128,7 @@ struct MaafOptions {
     MaafWeights weights = MaafWeights::Sampling;  // mu_p
     bool fitComponents = true;       // use only as many components as the window resolves
     bool symmetricOuter = true;      // outer components only where a neighbour's mirror is accepted too
+    bool mirrorSurfaceCuts = true;   // as AafOptions::mirrorSurfaceCuts, for every component
 };
 
 /// One effect's components for every pixel, computed on demand: a MaafPixel is 232 bytes, and

@@ -41,4 +41,10 @@ inline bool sameSurface(const FrameBuffers& fb, size_t p, size_t q, float normal
     return dot(fb.normal[p], fb.normal[q]) >= normalCos;
 }
 
+/// True when q's hit lies within `planeDistance` pixel footprints of p's tangent plane (a box
+/// face in front of a parallel wall of the same object is off it).
+inline bool onTangentPlane(const FrameBuffers& fb, size_t p, size_t q, float planeDistance) {
+    return std::abs(dot(fb.position[q] - fb.position[p], fb.normal[p])) <= planeDistance * fb.footprint[p];
+}
+
 }  // namespace wedge::filter

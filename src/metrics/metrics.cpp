@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "core/buffers.h"
 #include "core/error.h"
 
 namespace wedge::metrics {
@@ -114,7 +115,7 @@ std::vector<RegionError> regionErrors(const Image3f& test, const Image3f& refere
     const int W = test.width(), H = test.height();
     const Image1f e = relativeErrorMap(test, reference, eps);
     std::vector<RegionError> r = {{"background"}, {"mixed"}, {"edge"}, {"defocused"}, {"interior"}};
-    auto mixed = [&](size_t i) { return object[i] >= 0 && coverage[i] < 0.999f; };
+    auto mixed = [&](size_t i) { return object[i] >= 0 && coverage[i] < kFullCoverage; };
     double total = 0;
     for (int y = 0; y < H; ++y)
         for (int x = 0; x < W; ++x) {
