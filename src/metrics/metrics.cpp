@@ -220,34 +220,34 @@ Image1f relativeErrorMap(const Image3f& test, const Image3f& reference, float ep
     return out;
 }
 
-Image1f seedVarianceMap(const Image3f& a, const Image3f& b, const Image3f& reference, float eps) {
+namespace {
+
+/// Per pixel, the mean over the channels of term(a, b, r) / (r^2 + eps) for two renders a, b and
+/// the reference r.
+template <class Term>
+Image1f relativeMap(const Image3f& a, const Image3f& b, const Image3f& reference, float eps, Term term) {
     checkSameSize(a, reference);
     checkSameSize(b, reference);
     Image1f out(a.width(), a.height());
     for (size_t i = 0; i < a.size(); ++i) {
         double s = 0;
         for (int c = 0; c < 3; ++c) {
-            double d = double(a[i][c]) - double(b[i][c]), r = reference[i][c];
-            s += 0.5 * d * d / (r * r + eps);
+            const double r = reference[i][c];
+            s += term(double(a[i][c]), double(b[i][c]), r) / (r * r + eps);
         }
         out[i] = float(s / 3.0);
     }
     return out;
 }
 
+}  // namespace
+
+Image1f seedVarianceMap(const Image3f& a, const Image3f& b, const Image3f& reference, float eps) {
+    return relativeMap(a, b, reference, eps, [](double x, double y, double) { return 0.5 * (x - y) * (x - y); });
+}
+
 Image1f seedBiasMap(const Image3f& a, const Image3f& b, const Image3f& reference, float eps) {
-    checkSameSize(a, reference);
-    checkSameSize(b, reference);
-    Image1f out(a.width(), a.height());
-    for (size_t i = 0; i < a.size(); ++i) {
-        double s = 0;
-        for (int c = 0; c < 3; ++c) {
-            double r = reference[i][c];
-            s += (double(a[i][c]) - r) * (double(b[i][c]) - r) / (r * r + eps);
-        }
-        out[i] = float(s / 3.0);
-    }
-    return out;
+    return relativeMap(a, b, reference, eps, [](double x, double y, double r) { return (x - r) * (y - r); });
 }
 
 double mapMean(const Image1f& map) {
