@@ -207,19 +207,6 @@ double ssim(const Image3f& test, const Image3f& reference) {
     return sum / (3.0 * double(test.size()));
 }
 
-Image1f relativeErrorMap(const Image3f& test, const Image3f& reference, float eps) {
-    Image1f out(test.width(), test.height());
-    for (size_t i = 0; i < test.size(); ++i) {
-        double s = 0;
-        for (int c = 0; c < 3; ++c) {
-            double x = test[i][c], r = reference[i][c];
-            s += (x - r) * (x - r) / (r * r + eps);
-        }
-        out[i] = float(s / 3.0);
-    }
-    return out;
-}
-
 namespace {
 
 /// Per pixel, the mean over the channels of term(a, b, r) / (r^2 + eps) for two renders a, b and
@@ -241,6 +228,10 @@ Image1f relativeMap(const Image3f& a, const Image3f& b, const Image3f& reference
 }
 
 }  // namespace
+
+Image1f relativeErrorMap(const Image3f& test, const Image3f& reference, float eps) {
+    return relativeMap(test, test, reference, eps, [](double x, double, double r) { return (x - r) * (x - r); });
+}
 
 Image1f seedVarianceMap(const Image3f& a, const Image3f& b, const Image3f& reference, float eps) {
     return relativeMap(a, b, reference, eps, [](double x, double y, double) { return 0.5 * (x - y) * (x - y); });
