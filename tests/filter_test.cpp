@@ -117,7 +117,9 @@ TEST(AafFilter, MirrorsSurfaceCutsSoThatAGradientStaysUnbiased) {
     for (int y = 0; y < H; ++y) {
         for (int x = 11; x < 19; ++x) {
             EXPECT_NEAR(mirrored(x, y).x, 0.02f * x, 1e-5f) << x;
-            if (x >= 12) EXPECT_LT(oneSided(x, y).x, 0.02f * x - 0.005f) << x;  // biased low
+            if (x >= 12) {
+                EXPECT_LT(oneSided(x, y).x, 0.02f * x - 0.005f) << x;  // biased low
+            }
         }
         EXPECT_EQ(mirrored(19, y).x, oneSided(19, y).x) << "a mixed pixel keeps its one-sided window";
         EXPECT_LT(mirrored(19, y).x, 0.02f * 19 - 0.01f);
@@ -189,6 +191,47 @@ TEST(WedgeField, PrefilterKeepsWellSampledSlopesAndWidensTheRest) {
         EXPECT_FLOAT_EQ(a.s2(5, 5), 0.1f);
         EXPECT_FLOAT_EQ(a.s1(5, 5), 9.f);
         EXPECT_GE(a.s2(1, 1), kInf);
+    }
+}
+
+TEST(WedgeField, PrefilterKeepsOwnBounceDistancesWhereMostBouncesHit) {
+    // A 9x9 plane whose pixels' bounces hit at [2, 5], except (5, 4), whose hit a fixture at
+    // [0.05, 5]. Pixel (4, 4) keeps its own [1, 3] only when enough of its bounces hit; AAF
+    // (fillOnly) always keeps it; a pixel without bounce hits takes its window's extremes.
+    Plane pl(9, 9);
+    FrameBuffers& fb = pl.fb;
+    for (size_t i = 0; i < fb.zMin.size(); ++i) {
+        fb.sMin[i] = kInf;
+        fb.sMax[i] = 0;
+        fb.zMin[i] = 2;
+        fb.zMax[i] = 5;
+        fb.bounced[i] = 1;
+    }
+    fb.zMin(5, 4) = 0.05f;
+    fb.zMin(1, 1) = kInf;
+    fb.zMax(1, 1) = kInf;
+    fb.bounced(1, 1) = 0;
+    fb.zMin(4, 4) = 1;
+    fb.zMax(4, 4) = 3;
+    for (float bounced : {0.5f, 0.8f}) {
+        fb.bounced(4, 4) = bounced;
+        WedgeOptions o;  // MAAF: 5x5 min / max, own distances from 3/4 of the bounces hitting
+        o.ownBounceHit = 0.75f;
+        WedgeField a = prefilterWedges(fb, o);
+        const bool own = bounced >= 0.75f;
+        EXPECT_FLOAT_EQ(a.zMin(4, 4), own ? 1.f : 0.05f) << bounced;
+        EXPECT_FLOAT_EQ(a.zMax(4, 4), own ? 3.f : 5.f) << bounced;
+        WedgeOptions never;  // the paper's window min / max
+        WedgeField b = prefilterWedges(fb, never);
+        EXPECT_FLOAT_EQ(b.zMin(4, 4), 0.05f);
+        EXPECT_FLOAT_EQ(b.zMax(4, 4), 5.f);
+        WedgeOptions fill;
+        fill.fillOnly = true;
+        WedgeField c = prefilterWedges(fb, fill);
+        EXPECT_FLOAT_EQ(c.zMin(4, 4), 1.f);
+        // No hits of its own: the window's extremes, whatever the threshold.
+        EXPECT_FLOAT_EQ(a.zMin(1, 1), 2.f);
+        EXPECT_FLOAT_EQ(a.zMax(1, 1), 5.f);
     }
 }
 
@@ -374,7 +417,9 @@ TEST(MaafFilter, MirrorsSurfaceCutsSoThatAGradientStaysUnbiased) {
     for (int y = 0; y < H; ++y)
         for (int x = std::max(radius, 20 - radius); x < 19; ++x) {
             EXPECT_NEAR(mirrored(x, y).x, 0.02f * x, 1e-5f) << x;
-            if (x >= 15) EXPECT_LT(oneSided(x, y).x, 0.02f * x - 0.002f) << x;  // biased low
+            if (x >= 15) {
+                EXPECT_LT(oneSided(x, y).x, 0.02f * x - 0.002f) << x;  // biased low
+            }
         }
 }
 

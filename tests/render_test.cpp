@@ -151,6 +151,8 @@ TEST(Render, OneBounceInsideSphereMatchesFormFactorClosedForm) {
     mean /= double(r.buffers.indirect.size());
     // Bounce rays that hit the (dark) light quad lose at most its solid angle, far below 1%.
     EXPECT_NEAR(mean, expected, 0.02 * expected);
+    // Inside a closed sphere every bounce ray hits a wall (the MAAF prefilter's ownBounceHit).
+    for (size_t i = 0; i < r.buffers.bounced.size(); ++i) ASSERT_EQ(r.buffers.bounced[i], 1.f) << i;
 }
 
 TEST(Render, ThinLensDiscMatchesCircleOfConfusion) {
@@ -405,6 +407,30 @@ TEST(Render, DefocusWidthIsTheSmallestCircleOfConfusionAmongTheSamples) {
     none.add(at(1.f), view, false);
     none.store(fb, 0, 0, view);
     EXPECT_EQ(fb.defocus[0], 0.f);
+}
+
+TEST(Render, BounceFractionAndDistancesComeFromTheInitialSamples) {
+    // 16 initial samples (slopes), 12 of whose bounce rays hit at distances 2..16, then 4
+    // adaptive samples whose bounces hit at 0.5: those count towards neither.
+    ViewGeometry view;
+    view.width = view.height = 1;
+    render::PixelStats ps;
+    for (int i = 0; i < 20; ++i) {
+        render::TracedSample s = surfaceSample(0, 1.f);
+        s.bounceHit = i >= 16 || i % 4 != 0;
+        s.bounceDistance = s.bounceHit ? (i >= 16 ? 0.5f : float(i + 1)) : kInf;
+        ps.add(s, view, i < 16);
+    }
+    FrameBuffers fb(1, 1);
+    ps.store(fb, 0, 0, view);
+    EXPECT_FLOAT_EQ(fb.bounced[0], 0.75f);
+    EXPECT_FLOAT_EQ(fb.zMin[0], 2.f);
+    EXPECT_FLOAT_EQ(fb.zMax[0], 16.f);
+    render::PixelStats none;  // no bounce hit: no distances, fraction 0
+    none.add(surfaceSample(0, 1.f), view, true);
+    none.store(fb, 0, 0, view);
+    EXPECT_EQ(fb.bounced[0], 0.f);
+    EXPECT_GE(fb.zMin[0], kInf);
 }
 
 TEST(Render, EmitterEdgesAndTheirDefocusRimsAreToppedUp) {

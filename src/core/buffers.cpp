@@ -8,7 +8,7 @@ FrameBuffers::FrameBuffers(int w, int h)
     : width(w), height(h), color(w, h), emission(w, h), direct(w, h), indirect(w, h), albedo(w, h), normal(w, h),
       position(w, h), rest(w, h), depth(w, h), spp(w, h), object(w, h), coverage(w, h), variance(w, h),
       directUnoccluded(w, h), visibility(w, h), unoccluded(w, h), d1(w, h), sMax(w, h), sMin(w, h),
-      occluded(w, h), zMin(w, h), zMax(w, h), suMin(w, h), suMax(w, h), defocus(w, h), footprint(w, h) {
+      occluded(w, h), zMin(w, h), zMax(w, h), bounced(w, h), suMin(w, h), suMax(w, h), defocus(w, h), footprint(w, h) {
     for (OtherSurface& o : other) {
         o.albedo = o.normal = o.position = o.direct = o.indirect = Image3f(w, h);
         o.object = o.coverage = Image1f(w, h);
@@ -46,6 +46,7 @@ void FrameBuffers::forEachPlane(const std::function<void(const std::string&, int
     v1("slope.occluded", occluded);
     v1("slope.zmin", zMin);
     v1("slope.zmax", zMax);
+    v1("slope.bounced", bounced);
     v1("slope.sumin", suMin);
     v1("slope.sumax", suMax);
     v1("slope.defocus", defocus);

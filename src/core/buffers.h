@@ -94,6 +94,7 @@ struct FrameBuffers {
     Image1f sMax, sMin;    // shadow slopes s1 = max d1/d2min - 1, s2 = min d1/d2max - 1; 0/inf when unoccluded
     Image1f occluded;      // fraction of shadow rays that hit an occluder
     Image1f zMin, zMax;    // bounce distances
+    Image1f bounced;       // fraction of the initial samples whose bounce ray hit a surface
     Image1f suMin, suMax;  // defocus slopes, pixels per unit lens coordinate
     Image1f defocus;       // smallest |defocus slope| over all of the pixel's initial samples, every
                            // surface and misses (0 where they straddle the focal plane)

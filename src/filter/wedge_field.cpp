@@ -13,6 +13,7 @@ WedgeField prefilterWedges(const FrameBuffers& fb, const WedgeOptions& o) {
             float s1 = 0, s2 = kInf, zMin = kInf, zMax = 0, suMin = kInf, suMax = -kInf;
             bool ownShadow = fb.sMin[p] < kInf, ownBounce = fb.zMin[p] < kInf;
             const bool keepShadow = ownShadow && (o.fillOnly || fb.occluded[p] >= o.ownShadowOccluded);
+            const bool keepBounce = ownBounce && (o.fillOnly || fb.bounced[p] >= o.ownBounceHit);
             for (int dy = -o.radius; dy <= o.radius; ++dy) {
                 int yy = y + dy;
                 if (yy < 0 || yy >= H) continue;
@@ -26,7 +27,7 @@ WedgeField prefilterWedges(const FrameBuffers& fb, const WedgeOptions& o) {
                         s1 = std::max(s1, fb.sMax[q]);
                         s2 = std::min(s2, fb.sMin[q]);
                     }
-                    if (!(o.fillOnly && ownBounce) && fb.zMin[q] < kInf) {
+                    if (!keepBounce && fb.zMin[q] < kInf) {
                         zMin = std::min(zMin, fb.zMin[q]);
                         zMax = std::max(zMax, fb.zMax[q]);
                     }
@@ -35,7 +36,7 @@ WedgeField prefilterWedges(const FrameBuffers& fb, const WedgeOptions& o) {
                 }
             }
             if (keepShadow) { s1 = fb.sMax[p]; s2 = fb.sMin[p]; }
-            if (o.fillOnly && ownBounce) { zMin = fb.zMin[p]; zMax = fb.zMax[p]; }
+            if (keepBounce) { zMin = fb.zMin[p]; zMax = fb.zMax[p]; }
             wf.s1[p] = s1;
             wf.s2[p] = s2;
             wf.zMin[p] = zMin;

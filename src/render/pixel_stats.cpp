@@ -22,6 +22,7 @@ void SurfaceSlot::add(const TracedSample& s, const ViewGeometry& view, bool slop
     visible += luminance(r.direct);
     unoccluded += r.unoccluded;
     if (!slopes) return;
+    ++nSlopes;
     float su = view.defocusSlope(s.depth);
     suMin = std::min(suMin, su);
     suMax = std::max(suMax, su);
@@ -122,7 +123,7 @@ void PixelStats::store(FrameBuffers& fb, int x, int y, const ViewGeometry& view)
     storeSurface(m, fb.albedo, fb.direct, fb.indirect, fb.normal, fb.position, fb.object, fb.coverage);
     if (m.n == 0) {  // nothing hit: background
         fb.depth[p] = fb.footprint[p] = fb.visibility[p] = fb.unoccluded[p] = 0;
-        fb.d1[p] = fb.sMax[p] = fb.occluded[p] = fb.suMin[p] = fb.suMax[p] = 0;
+        fb.d1[p] = fb.sMax[p] = fb.occluded[p] = fb.bounced[p] = fb.suMin[p] = fb.suMax[p] = 0;
         fb.sMin[p] = fb.zMin[p] = fb.zMax[p] = kInf;
         return;
     }
@@ -137,6 +138,7 @@ void PixelStats::store(FrameBuffers& fb, int x, int y, const ViewGeometry& view)
     fb.occluded[p] = m.nShadow > 0 ? float(m.nOccluded) / float(m.nShadow) : 0.f;
     fb.zMin[p] = m.nBounce > 0 ? m.zMin : kInf;
     fb.zMax[p] = m.nBounce > 0 ? m.zMax : kInf;
+    fb.bounced[p] = m.nSlopes > 0 ? float(m.nBounce) / float(m.nSlopes) : 0.f;
     bool su = m.suMin <= m.suMax;
     fb.suMin[p] = su ? m.suMin : 0.f;
     fb.suMax[p] = su ? m.suMax : 0.f;
