@@ -196,39 +196,51 @@ TEST(WedgeField, PrefilterKeepsWellSampledSlopesAndWidensTheRest) {
 
 TEST(WedgeField, PrefilterKeepsOwnBounceDistancesWhereMostBouncesHit) {
     // A 9x9 plane whose pixels' bounces hit at [2, 5], except (5, 4), whose hit a fixture at
-    // [0.05, 5]. Pixel (4, 4) keeps its own [1, 3] only when enough of its bounces hit; AAF
-    // (fillOnly) always keeps it; a pixel without bounce hits takes its window's extremes.
+    // [0.05, 5]; pixel (4, 4)'s own are [1, 3]. It keeps them when, on average over its 5x5
+    // window, enough of the bounce rays hit: the neighbourhood decides, not the pixel alone.
+    // Pixel (3, 4) belongs to another object and never counts. AAF (fillOnly) always keeps its
+    // own; a pixel without bounce hits takes its window's extremes.
     Plane pl(9, 9);
     FrameBuffers& fb = pl.fb;
-    for (size_t i = 0; i < fb.zMin.size(); ++i) {
-        fb.sMin[i] = kInf;
-        fb.sMax[i] = 0;
-        fb.zMin[i] = 2;
-        fb.zMax[i] = 5;
-        fb.bounced[i] = 1;
-    }
-    fb.zMin(5, 4) = 0.05f;
-    fb.zMin(1, 1) = kInf;
-    fb.zMax(1, 1) = kInf;
-    fb.bounced(1, 1) = 0;
-    fb.zMin(4, 4) = 1;
-    fb.zMax(4, 4) = 3;
-    for (float bounced : {0.5f, 0.8f}) {
-        fb.bounced(4, 4) = bounced;
-        WedgeOptions o;  // MAAF: 5x5 min / max, own distances from 3/4 of the bounces hitting
-        o.ownBounceHit = 0.75f;
+    auto setUp = [&](float around, float own) {
+        for (size_t i = 0; i < fb.zMin.size(); ++i) {
+            fb.sMin[i] = kInf;
+            fb.sMax[i] = 0;
+            fb.zMin[i] = 2;
+            fb.zMax[i] = 5;
+            fb.bounced[i] = around;
+        }
+        fb.zMin(5, 4) = 0.05f;
+        fb.zMin(1, 1) = fb.zMax(1, 1) = kInf;
+        fb.bounced(1, 1) = 0;
+        fb.zMin(4, 4) = 1;
+        fb.zMax(4, 4) = 3;
+        fb.bounced(4, 4) = own;
+        fb.object(3, 4) = 1;
+        fb.bounced(3, 4) = 0;  // would pull the second case's mean below 3/4 if it counted
+    };
+    WedgeOptions o;  // MAAF: 5x5 min / max, own distances from 3/4 of the bounces hitting
+    o.ownBounceHit = 0.75f;
+    WedgeOptions never;  // the paper's window min / max
+    WedgeOptions fill;
+    fill.fillOnly = true;
+    struct Case {
+        float around, own;
+        bool keeps;
+    };
+    // 23 neighbours on the surface at 0.8 hold the mean above 3/4 whatever (4, 4) saw
+    // ((23 x 0.8 + 0.2) / 24 = 0.775; 0.744 if (3, 4) counted); at 0.7 it stays below even when
+    // all of (4, 4)'s rays hit (0.7125).
+    for (Case c : {Case{0.8f, 0.8f, true}, Case{0.8f, 0.2f, true}, Case{0.7f, 1.f, false}}) {
+        setUp(c.around, c.own);
         WedgeField a = prefilterWedges(fb, o);
-        const bool own = bounced >= 0.75f;
-        EXPECT_FLOAT_EQ(a.zMin(4, 4), own ? 1.f : 0.05f) << bounced;
-        EXPECT_FLOAT_EQ(a.zMax(4, 4), own ? 3.f : 5.f) << bounced;
-        WedgeOptions never;  // the paper's window min / max
+        EXPECT_FLOAT_EQ(a.zMin(4, 4), c.keeps ? 1.f : 0.05f) << c.around << " " << c.own;
+        EXPECT_FLOAT_EQ(a.zMax(4, 4), c.keeps ? 3.f : 5.f) << c.around << " " << c.own;
         WedgeField b = prefilterWedges(fb, never);
         EXPECT_FLOAT_EQ(b.zMin(4, 4), 0.05f);
         EXPECT_FLOAT_EQ(b.zMax(4, 4), 5.f);
-        WedgeOptions fill;
-        fill.fillOnly = true;
-        WedgeField c = prefilterWedges(fb, fill);
-        EXPECT_FLOAT_EQ(c.zMin(4, 4), 1.f);
+        WedgeField f = prefilterWedges(fb, fill);
+        EXPECT_FLOAT_EQ(f.zMin(4, 4), 1.f);
         // No hits of its own: the window's extremes, whatever the threshold.
         EXPECT_FLOAT_EQ(a.zMin(1, 1), 2.f);
         EXPECT_FLOAT_EQ(a.zMax(1, 1), 5.f);

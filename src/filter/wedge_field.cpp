@@ -13,7 +13,8 @@ WedgeField prefilterWedges(const FrameBuffers& fb, const WedgeOptions& o) {
             float s1 = 0, s2 = kInf, zMin = kInf, zMax = 0, suMin = kInf, suMax = -kInf;
             bool ownShadow = fb.sMin[p] < kInf, ownBounce = fb.zMin[p] < kInf;
             const bool keepShadow = ownShadow && (o.fillOnly || fb.occluded[p] >= o.ownShadowOccluded);
-            const bool keepBounce = ownBounce && (o.fillOnly || fb.bounced[p] >= o.ownBounceHit);
+            float hitSum = 0;  // fractions of bounce rays that hit, summed over the window's surface
+            int hitCount = 0;
             for (int dy = -o.radius; dy <= o.radius; ++dy) {
                 int yy = y + dy;
                 if (yy < 0 || yy >= H) continue;
@@ -27,15 +28,20 @@ WedgeField prefilterWedges(const FrameBuffers& fb, const WedgeOptions& o) {
                         s1 = std::max(s1, fb.sMax[q]);
                         s2 = std::min(s2, fb.sMin[q]);
                     }
-                    if (!keepBounce && fb.zMin[q] < kInf) {
+                    if (fb.zMin[q] < kInf) {
                         zMin = std::min(zMin, fb.zMin[q]);
                         zMax = std::max(zMax, fb.zMax[q]);
                     }
+                    hitSum += fb.bounced[q];
+                    ++hitCount;
                     suMin = std::min(suMin, fb.suMin[q]);
                     suMax = std::max(suMax, fb.suMax[q]);
                 }
             }
             if (keepShadow) { s1 = fb.sMax[p]; s2 = fb.sMin[p]; }
+            // The neighbourhood's hit fraction, not the pixel's own, decides: neighbouring pixels
+            // then decide alike, and filter widths do not alternate from pixel to pixel.
+            const bool keepBounce = ownBounce && (o.fillOnly || hitSum >= o.ownBounceHit * float(hitCount));
             if (keepBounce) { zMin = fb.zMin[p]; zMax = fb.zMax[p]; }
             wf.s1[p] = s1;
             wf.s2[p] = s2;

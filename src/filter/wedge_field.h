@@ -27,8 +27,9 @@ struct WedgeOptions {
     // least this fraction of its shadow rays hit an occluder: many occluder spans give a
     // trustworthy slope range, a few (a penumbra's edge, a contact shadow) do not. > 1: never.
     float ownShadowOccluded = 2.f;
-    // Likewise a pixel keeps its own bounce distances when at least this fraction of its initial
-    // samples' bounce rays hit a surface. > 1: never (the window's min / max).
+    // Likewise a pixel keeps its own bounce distances when, on average over the window's pixels
+    // on its surface, at least this fraction of the initial samples' bounce rays hit a surface
+    // (a well-sampled hemisphere). > 1: never (the window's min / max).
     float ownBounceHit = 2.f;
     int fillRadius = 0;      // > radius: pixels still without a wedge take it from this wider window
     int focalRadius = 10;    // window half-size of the focal-plane (sign change) detection

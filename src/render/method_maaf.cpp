@@ -125,15 +125,18 @@ void renderMaaf(const MethodContext& ctx, RenderResult& result) {
     // 0.000890 / 0.000890, sponza 0.001123 / 0.001123 / 0.001104 / 0.001092 / 0.001168, bunny
     // 0.000146 / 0.000135 / 0.000136 / 0.000135 / 0.000139.
     wo.ownShadowOccluded = 0.5f;
-    // Bounce distances likewise: a pixel keeps its own where at least 3/4 of its bounce rays hit
-    // (a well-sampled hemisphere), otherwise the window's min / max. The window's min spreads
-    // a few rays' near hits (cornell: the back of the light, 0.01 below the ceiling) to pixels
-    // that never see them, with more outer components and more variance there. Measured
-    // (512x512, relMSE against 1024-spp references, window min -> this rule): cornell
-    // 0.000113 -> 0.0000990, conference 0.000677 -> 0.000637, sponza 0.000902 -> 0.000899,
-    // grids 0.000273 -> 0.000273, cornell-sphere 0.000166 -> 0.000145, bunny 0.000126 ->
-    // 0.000132. Thresholds 0.5 / 0.6 / 0.9: cornell 0.0000959 / 0.0000959 / 0.000109, bunny
-    // 0.000148 / 0.000140 / 0.000126; 1: cornell 0.000112.
+    // Bounce distances likewise: a pixel keeps its own where at least 3/4 of the bounce rays hit
+    // on average over its window (a well-sampled hemisphere), otherwise the window's min / max.
+    // The window's min spreads a few rays' near hits (cornell: the back of the light, 0.01 below
+    // the ceiling) to pixels that never see them, with more outer components and more variance
+    // there. Measured (512x512, relMSE against 1024-spp references), window min -> the pixel's
+    // own hit fraction deciding -> the window's mean deciding (kept; the pixel's own made filter
+    // widths alternate from pixel to pixel and left dark dots beside cornell's light): cornell
+    // 0.000113 -> 0.0000990 -> 0.0000965, conference 0.000677 -> 0.000637 -> 0.000637, sponza
+    // 0.000902 -> 0.000899 -> 0.000899, grids 0.000273 -> 0.000273 -> 0.000273, cornell-sphere
+    // 0.000166 -> 0.000145 -> 0.000145, bunny 0.000126 -> 0.000132 -> 0.000128. The pixel's own
+    // at thresholds 0.5 / 0.6 / 0.9: cornell 0.0000959 / 0.0000959 / 0.000109, bunny 0.000148 /
+    // 0.000140 / 0.000126; 1: cornell 0.000112.
     wo.ownBounceHit = 0.75f;
     filter::WedgeField wedges = filter::prefilterWedges(fb, wo);
     filter::FilterFrames frames = filter::computeFrames(fb, view);
@@ -286,15 +289,19 @@ void renderMaaf(const MethodContext& ctx, RenderResult& result) {
 
     if (!ctx.options.aovDir.empty()) {
         const std::string& dir = ctx.options.aovDir;
-        Image1f width(W, H), components(W, H), componentsIndirect(W, H);
+        Image1f width(W, H), widthIndirect(W, H), components(W, H), componentsIndirect(W, H);
         for (size_t i = 0; i < pixels; ++i) {
             width[i] = fb.object[i] < 0 ? 0.f
                                         : std::min(float(mo.maxRadius),
                                                    1.f / (params.direct.centralSx(i, 0) * frames.direct[i].step[0]));
+            widthIndirect[i] = fb.object[i] < 0 ? 0.f
+                                                : std::min(float(mo.maxRadius),
+                                                           1.f / (params.indirect.centralSx(i, 0) * frames.indirect[i].step[0]));
             components[i] = fb.object[i] < 0 ? 0.f : float(2 * params.direct.pairs(i, 0) - 1);
             componentsIndirect[i] = fb.object[i] < 0 ? 0.f : float(2 * params.indirect.pairs(i, 0) - 1);
         }
         writeAov(dir, "maaf_central_width_direct", width, 0, float(mo.maxRadius));
+        writeAov(dir, "maaf_central_width_indirect", widthIndirect, 0, float(mo.maxRadius));
         writeAov(dir, "maaf_components_direct", components, 0, float(2 * mo.pairs - 1));
         writeAov(dir, "maaf_components_indirect", componentsIndirect, 0, float(2 * mo.pairs - 1));
         writeAov(dir, "maaf_fallback", params.fallback, 0, 1);
