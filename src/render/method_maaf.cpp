@@ -289,21 +289,20 @@ void renderMaaf(const MethodContext& ctx, RenderResult& result) {
 
     if (!ctx.options.aovDir.empty()) {
         const std::string& dir = ctx.options.aovDir;
-        Image1f width(W, H), widthIndirect(W, H), components(W, H), componentsIndirect(W, H);
-        for (size_t i = 0; i < pixels; ++i) {
-            width[i] = fb.object[i] < 0 ? 0.f
-                                        : std::min(float(mo.maxRadius),
-                                                   1.f / (params.direct.centralSx(i, 0) * frames.direct[i].step[0]));
-            widthIndirect[i] = fb.object[i] < 0 ? 0.f
-                                                : std::min(float(mo.maxRadius),
-                                                           1.f / (params.indirect.centralSx(i, 0) * frames.indirect[i].step[0]));
-            components[i] = fb.object[i] < 0 ? 0.f : float(2 * params.direct.pairs(i, 0) - 1);
-            componentsIndirect[i] = fb.object[i] < 0 ? 0.f : float(2 * params.indirect.pairs(i, 0) - 1);
-        }
-        writeAov(dir, "maaf_central_width_direct", width, 0, float(mo.maxRadius));
-        writeAov(dir, "maaf_central_width_indirect", widthIndirect, 0, float(mo.maxRadius));
-        writeAov(dir, "maaf_components_direct", components, 0, float(2 * mo.pairs - 1));
-        writeAov(dir, "maaf_components_indirect", componentsIndirect, 0, float(2 * mo.pairs - 1));
+        // Per effect, along image x: the central component's standard deviation in pixels (at
+        // most the window) and the number of components.
+        auto effectAovs = [&](const filter::MaafEffect& effect, const Image<filter::AxisFrame>& axes, const std::string& name) {
+            Image1f width(W, H), components(W, H);
+            for (size_t i = 0; i < pixels; ++i) {
+                if (fb.object[i] < 0) continue;  // 0 in both maps
+                width[i] = std::min(float(mo.maxRadius), 1.f / (effect.centralSx(i, 0) * axes[i].step[0]));
+                components[i] = float(2 * effect.pairs(i, 0) - 1);
+            }
+            writeAov(dir, "maaf_central_width_" + name, width, 0, float(mo.maxRadius));
+            writeAov(dir, "maaf_components_" + name, components, 0, float(2 * mo.pairs - 1));
+        };
+        effectAovs(params.direct, frames.direct, "direct");
+        effectAovs(params.indirect, frames.indirect, "indirect");
         writeAov(dir, "maaf_fallback", params.fallback, 0, 1);
         writeWedgeAovs(dir, "maaf", fb, wedges);
     }
