@@ -90,12 +90,14 @@ TEST(Metrics, ReferenceNoiseIsTheShareOfTheReferencesOwnError) {
 
 TEST(Metrics, RegionErrorsSplitTheErrorByPixelClass) {
     // 12x8: objects 0 (x < 6) and 1 (x >= 6), pixel (0, 0) background, (2, 6) mixed, the right
-    // object's rows y >= 4 defocused. Relative squared error 1 (eps 0: test 2 against 1) at
-    // (0, 0) background, (2, 6) mixed, (5, 3) edge (next to object 1), (1, 1) edge (next to the
-    // background pixel), (9, 6) defocused and (3, 3) interior.
+    // object's rows y >= 4 defocused, pixels (3, 1), (0, 3) and the defocused (9, 7) partly
+    // occluded (0.5, 0.0625, 0.5) and (3, 2) wholly (1). Relative squared error 1 (eps 0: test 2
+    // against 1) at (0, 0) background, (2, 6) mixed, (5, 3) edge (next to object 1), (1, 1) edge
+    // (next to the background pixel), (3, 1) penumbra, (9, 6) defocused, (3, 3) and (3, 2)
+    // interior.
     const int W = 12, H = 8;
     Image3f ref = constant(W, H, 1.f), test = ref;
-    Image1f object(W, H), coverage(W, H), defocus(W, H);
+    Image1f object(W, H), coverage(W, H), defocus(W, H), occluded(W, H);
     for (int y = 0; y < H; ++y)
         for (int x = 0; x < W; ++x) {
             object(x, y) = x < 6 ? 0.f : 1.f;
@@ -104,9 +106,16 @@ TEST(Metrics, RegionErrorsSplitTheErrorByPixelClass) {
         }
     object(0, 0) = -1;
     coverage(2, 6) = 0.5f;
-    for (auto [x, y] : {std::pair{0, 0}, {2, 6}, {5, 3}, {9, 6}, {1, 1}, {3, 3}}) test(x, y) = Vec3f(2.f);
-    auto r = regionErrors(test, ref, object, coverage, defocus, 2, 0.f);
-    ASSERT_EQ(r.size(), 5u);
+    occluded(3, 1) = 0.5f;
+    occluded(0, 3) = 0.0625f;
+    occluded(3, 2) = 1.f;     // umbra: interior
+    occluded(9, 7) = 0.5f;    // penumbra before defocused
+    occluded(5, 5) = 0.5f;    // edge first (next to object 1)
+    for (auto [x, y] : {std::pair{0, 0}, {2, 6}, {5, 3}, {9, 6}, {1, 1}, {3, 3}, {3, 1}, {3, 2}})
+        test(x, y) = Vec3f(2.f);
+    const RegionPlanes planes{object, coverage, defocus, occluded};
+    auto r = regionErrors(test, ref, planes, 2, 0.f);
+    ASSERT_EQ(r.size(), 6u);
     double pixels = 0, share = 0;
     for (const auto& c : r) {
         pixels += c.pixels;
@@ -116,15 +125,21 @@ TEST(Metrics, RegionErrorsSplitTheErrorByPixelClass) {
     EXPECT_NEAR(share, 1.0, 1e-12);
     EXPECT_EQ(r[0].name, "background");
     EXPECT_NEAR(r[0].pixels, 1.0 / 96, 1e-12);
-    EXPECT_NEAR(r[0].share, 1.0 / 6, 1e-12);
+    EXPECT_NEAR(r[0].share, 1.0 / 8, 1e-12);
     EXPECT_NEAR(r[0].relMse, 1.0, 1e-12);
-    EXPECT_NEAR(r[1].share, 1.0 / 6, 1e-12);  // mixed: (2, 6)
-    EXPECT_NEAR(r[2].share, 2.0 / 6, 1e-12);  // edge: (5, 3), (1, 1)
-    EXPECT_NEAR(r[3].share, 1.0 / 6, 1e-12);  // defocused: (9, 6)
-    EXPECT_NEAR(r[4].share, 1.0 / 6, 1e-12);  // interior: (3, 3)
+    EXPECT_NEAR(r[1].share, 1.0 / 8, 1e-12);  // mixed: (2, 6)
+    EXPECT_NEAR(r[2].share, 2.0 / 8, 1e-12);  // edge: (5, 3), (1, 1)
+    EXPECT_EQ(r[3].name, "penumbra");
+    EXPECT_NEAR(r[3].pixels, 3.0 / 96, 1e-12);  // (3, 1), (0, 3), (9, 7); not (5, 5) or (3, 2)
+    EXPECT_NEAR(r[3].share, 1.0 / 8, 1e-12);    // (3, 1)
+    EXPECT_NEAR(r[3].relMse, 1.0 / 3, 1e-12);
+    EXPECT_EQ(r[4].name, "defocused");
+    EXPECT_NEAR(r[4].share, 1.0 / 8, 1e-12);  // (9, 6)
+    EXPECT_EQ(r[5].name, "interior");
+    EXPECT_NEAR(r[5].share, 2.0 / 8, 1e-12);  // (3, 3), (3, 2)
     // Edge pixels: around the background and the mixed pixel, and columns 4..7 along the border.
     EXPECT_GT(r[2].pixels, 0.3);
-    EXPECT_LT(r[4].pixels + r[3].pixels, 0.7);
+    EXPECT_LT(r[5].pixels + r[4].pixels + r[3].pixels, 0.7);
     for (const auto& c : r) EXPECT_EQ(c.variance, 0.0) << "no variance map given";
 
     // A variance map is averaged over each class's pixels: 3 on the background pixel, 1 elsewhere
@@ -132,10 +147,11 @@ TEST(Metrics, RegionErrorsSplitTheErrorByPixelClass) {
     Image1f variance(W, H, 1.f);
     variance(0, 0) = 3.f;
     variance(3, 3) = 5.f;
-    auto v = regionErrors(test, ref, object, coverage, defocus, 2, 0.f, &variance);
+    auto v = regionErrors(test, ref, planes, 2, 0.f, &variance);
     EXPECT_NEAR(v[0].variance, 3.0, 1e-12);
     EXPECT_NEAR(v[1].variance, 1.0, 1e-12);
-    EXPECT_NEAR(v[4].variance, 1.0 + 4.0 / (v[4].pixels * W * H), 1e-9);
+    EXPECT_NEAR(v[3].variance, 1.0, 1e-12);
+    EXPECT_NEAR(v[5].variance, 1.0 + 4.0 / (v[5].pixels * W * H), 1e-9);
     for (size_t k = 0; k < r.size(); ++k) EXPECT_EQ(v[k].relMse, r[k].relMse);
 }
 
@@ -281,7 +297,7 @@ TEST(CompareCommand, RegionsSplitARendersErrorAndNeedItsPlanes) {
     ASSERT_EQ(test::runWedge("compare " + dir + "/x.exr " + dir + "/r.exr --regions --json", &out, &err), 0) << err;
     auto j = nlohmann::json::parse(out);
     double share = 0, pixels = 0, weighted = 0;
-    for (const char* name : {"background", "mixed", "edge", "defocused", "interior"}) {
+    for (const char* name : {"background", "mixed", "edge", "defocused", "penumbra", "interior"}) {
         ASSERT_TRUE(j["regions"].contains(name)) << name;
         share += j["regions"][name]["share"].get<double>();
         pixels += j["regions"][name]["pixels"].get<double>();
@@ -291,6 +307,7 @@ TEST(CompareCommand, RegionsSplitARendersErrorAndNeedItsPlanes) {
     EXPECT_NEAR(pixels, 1.0, 1e-9);
     EXPECT_NEAR(weighted, j["relmse"].get<double>(), 1e-6 * j["relmse"].get<double>());
     EXPECT_GT(j["regions"]["mixed"]["pixels"].get<double>(), 0.0) << "the box's edges mix surfaces";
+    EXPECT_GT(j["regions"]["penumbra"]["pixels"].get<double>(), 0.0) << "the boxes' soft shadows";
     // A PFM has no planes to split by.
     io::writePfm(dir + "/x.pfm", io::readColor(dir + "/x.exr"));
     EXPECT_EQ(test::runWedge("compare " + dir + "/x.pfm " + dir + "/r.exr --regions", &out, &err), 2);
@@ -320,8 +337,8 @@ TEST(CompareCommand, VarianceFromASecondRenderSplitsTheError) {
     EXPECT_LT(variance, 1.1 * relmse);
     EXPECT_NEAR(j["bias2_and_reference_noise"].get<double>(), relmse - variance, 1e-12);
     double weighted = 0;
-    for (const char* name : {"background", "mixed", "edge", "defocused", "interior"})
-        weighted += j["regions"][name]["pixels"].get<double>() * j["regions"][name]["variance"].get<double>();
+    for (const auto& [name, r] : j["regions"].items())
+        weighted += r["pixels"].get<double>() * r["variance"].get<double>();
     EXPECT_NEAR(weighted, variance, 1e-6 * variance);
     // The text form names both parts.
     ASSERT_EQ(test::runWedge("compare " + dir + "/a.exr " + dir + "/r.exr --variance-from " + dir + "/b.exr", &out, &err), 0);

@@ -68,9 +68,10 @@ void runCompare(const CompareArgs& a) {
         if (io::extension(a.test) != ".exr")
             throw Error(a.test, "--regions needs an EXR written by `wedge render -o x.exr` (its coverage and object planes)");
         const io::ExrImage exr = io::readExr(a.test);
-        regions = metrics::regionErrors(test, reference, plane(exr, a.test, "object"), plane(exr, a.test, "coverage"),
-                                        plane(exr, a.test, "slope.defocus"), 2, metrics::kRelMseEpsilon,
-                                        variance ? &*variance : nullptr);
+        const Image1f object = plane(exr, a.test, "object"), coverage = plane(exr, a.test, "coverage"),
+                      defocus = plane(exr, a.test, "slope.defocus"), occluded = plane(exr, a.test, "slope.occluded");
+        regions = metrics::regionErrors(test, reference, {object, coverage, defocus, occluded}, 2,
+                                        metrics::kRelMseEpsilon, variance ? &*variance : nullptr);
     }
     metrics::Metrics m = metrics::compare(test, reference);
     if (!a.heatmap.empty())
@@ -134,7 +135,7 @@ void registerCompare(CLI::App& app) {
     cmd->add_flag("--json", args->json, "Print the metrics as JSON");
     cmd->add_flag("--regions", args->regions,
                   "Split relMSE over pixel classes of TEST's own planes (an EXR from wedge render): background, "
-                  "mixed surfaces, edge (within 2 px), defocused, interior");
+                  "mixed surfaces, edge (within 2 px), penumbra (some of the shadow rays blocked), defocused, interior");
     cmd->add_option("--variance-from", args->varianceFrom,
                     "A render made like TEST but with another --seed: splits TEST's relMSE into variance and the "
                     "rest (squared bias + the reference's own noise)");

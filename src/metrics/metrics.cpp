@@ -109,12 +109,13 @@ double referenceNoise(const Image3f& halfA, int nA, const Image3f& halfB, int nB
     return r.size() ? sum / (3.0 * double(r.size())) : 0.0;
 }
 
-std::vector<RegionError> regionErrors(const Image3f& test, const Image3f& reference, const Image1f& object,
-                                      const Image1f& coverage, const Image1f& defocus, int edgeRadius, float eps,
-                                      const Image1f* variance) {
+std::vector<RegionError> regionErrors(const Image3f& test, const Image3f& reference, const RegionPlanes& planes,
+                                      int edgeRadius, float eps, const Image1f* variance) {
     const int W = test.width(), H = test.height();
+    const Image1f& object = planes.object;
+    const Image1f& coverage = planes.coverage;
     const Image1f e = relativeErrorMap(test, reference, eps);
-    std::vector<RegionError> r = {{"background"}, {"mixed"}, {"edge"}, {"defocused"}, {"interior"}};
+    std::vector<RegionError> r = {{"background"}, {"mixed"}, {"edge"}, {"penumbra"}, {"defocused"}, {"interior"}};
     auto mixed = [&](size_t i) { return object[i] >= 0 && coverage[i] < kFullCoverage; };
     double total = 0;
     for (int y = 0; y < H; ++y)
@@ -132,7 +133,8 @@ std::vector<RegionError> regionErrors(const Image3f& test, const Image3f& refere
                         const size_t q = size_t(yy) * W + xx;
                         near = mixed(q) || object[q] != object[i];
                     }
-                k = near ? 2 : defocus[i] > 1.f ? 3 : 4;
+                const float occ = planes.occluded[i];
+                k = near ? 2 : (occ > 0.f && occ < 1.f) ? 3 : planes.defocus[i] > 1.f ? 4 : 5;
             }
             r[k].pixels += 1;
             r[k].share += e[i];

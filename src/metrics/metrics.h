@@ -72,9 +72,12 @@ Image3f combineHalves(const Image3f& halfA, int nA, const Image3f& halfB, int nB
 /// Where the error sits: relMSE split over pixel classes of the test render's own planes
 /// (`wedge render -o x.exr` writes them): background (object < 0), mixed (coverage < 1: the
 /// samples saw more than one surface, or a surface and the background), edge (within
-/// `edgeRadius` pixels of a mixed pixel or of a pixel on another object), defocused (slope.defocus
-/// above one pixel per lens radius) and interior (the rest). With `variance` (seedVarianceMap of
-/// the test render and one with another seed), each class also gets its variance part.
+/// `edgeRadius` pixels of a mixed pixel or of a pixel on another object), penumbra
+/// (slope.occluded strictly between 0 and 1: some but not all of the initial samples' shadow rays
+/// were blocked, the pixels where a shadow filter's width and components matter, defocused or
+/// not), defocused (slope.defocus above one pixel per lens radius) and interior (the rest). Each
+/// pixel falls in the first class that holds for it. With `variance` (seedVarianceMap of the test
+/// render and one with another seed), each class also gets its variance part.
 struct RegionError {
     std::string name;
     double pixels = 0;    // fraction of the image's pixels
@@ -82,9 +85,15 @@ struct RegionError {
     double relMse = 0;    // mean over the class's pixels
     double variance = 0;  // mean of `variance` over the class's pixels (0 without it)
 };
-std::vector<RegionError> regionErrors(const Image3f& test, const Image3f& reference, const Image1f& object,
-                                      const Image1f& coverage, const Image1f& defocus, int edgeRadius = 2,
-                                      float eps = kRelMseEpsilon, const Image1f* variance = nullptr);
+struct RegionPlanes {
+    const Image1f& object;
+    const Image1f& coverage;
+    const Image1f& defocus;   // slope.defocus
+    const Image1f& occluded;  // slope.occluded
+};
+std::vector<RegionError> regionErrors(const Image3f& test, const Image3f& reference, const RegionPlanes& planes,
+                                      int edgeRadius = 2, float eps = kRelMseEpsilon,
+                                      const Image1f* variance = nullptr);
 
 struct Metrics {
     double relMse = 0, smape = 0, psnr = 0, ssim = 0;
