@@ -124,6 +124,22 @@ TEST(ExperimentCommand, WritesRowsAndASelfContainedReport) {
         if (r["method"] == "mc") {
             EXPECT_LT(std::abs(net - variance), 0.3 * variance) << r.dump();
         }
+        // ... and over the render's pixel classes: the classes cover the image, and their
+        // pixel-weighted relMSE and variance add up to the row's.
+        ASSERT_TRUE(r.contains("regions")) << r.dump();
+        double pixels = 0, share = 0, weighted = 0, weightedVariance = 0;
+        for (const auto& [name, c] : r["regions"].items()) {
+            pixels += c["pixels"].get<double>();
+            share += c["share"].get<double>();
+            weighted += c["pixels"].get<double>() * c["relmse"].get<double>();
+            weightedVariance += c["pixels"].get<double>() * c["variance"].get<double>();
+        }
+        EXPECT_EQ(r["regions"].size(), 6u);
+        EXPECT_NEAR(pixels, 1.0, 1e-9);
+        EXPECT_NEAR(share, 1.0, 1e-9);
+        EXPECT_NEAR(weighted, relmse, 1e-6 * relmse);
+        EXPECT_NEAR(weightedVariance, variance, 1e-6 * variance);
+        EXPECT_GT(r["regions"]["penumbra"]["pixels"].get<double>(), 0.0) << "the tiny scene has soft shadows";
     }
     for (const auto& r : rows) {
         if (r["method"] == "atrous") {
@@ -148,6 +164,9 @@ TEST(ExperimentCommand, WritesRowsAndASelfContainedReport) {
     EXPECT_NE(html.find("net relMSE"), std::string::npos);
     EXPECT_NE(html.find("bias&sup2;"), std::string::npos);
     EXPECT_TRUE(fs::is_regular_file(dir + "/table.md"));
+    const std::string table = slurp(dir + "/table.md");
+    EXPECT_NE(table.find("| where | background | mixed | edge | penumbra | defocused | interior |"), std::string::npos)
+        << table;
 }
 
 TEST(ExperimentCommand, CachesTheReferenceAndShowsProgressUnlessQuiet) {

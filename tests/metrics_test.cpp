@@ -153,6 +153,19 @@ TEST(Metrics, RegionErrorsSplitTheErrorByPixelClass) {
     EXPECT_NEAR(v[3].variance, 1.0, 1e-12);
     EXPECT_NEAR(v[5].variance, 1.0 + 4.0 / (v[5].pixels * W * H), 1e-9);
     for (size_t k = 0; k < r.size(); ++k) EXPECT_EQ(v[k].relMse, r[k].relMse);
+
+    // The two halves: per-pixel classes (indices into regionNames()), then the split over them.
+    const Image<uint8_t> classes = regionClasses(planes);
+    EXPECT_EQ(regionNames()[classes(0, 0)], "background");
+    EXPECT_EQ(regionNames()[classes(3, 1)], "penumbra");
+    EXPECT_EQ(regionNames()[classes(9, 7)], "penumbra");
+    EXPECT_EQ(regionNames()[classes(3, 2)], "interior");
+    auto w = regionErrors(test, ref, classes, 0.f, &variance);
+    for (size_t k = 0; k < r.size(); ++k) {
+        EXPECT_EQ(w[k].relMse, v[k].relMse);
+        EXPECT_EQ(w[k].variance, v[k].variance);
+    }
+    EXPECT_THROW(regionErrors(test, ref, Image<uint8_t>(4, 4), 0.f), Error);
 }
 
 TEST(Metrics, SeedVarianceSplitsNoiseFromBias) {

@@ -109,15 +109,17 @@ double referenceNoise(const Image3f& halfA, int nA, const Image3f& halfB, int nB
     return r.size() ? sum / (3.0 * double(r.size())) : 0.0;
 }
 
-std::vector<RegionError> regionErrors(const Image3f& test, const Image3f& reference, const RegionPlanes& planes,
-                                      int edgeRadius, float eps, const Image1f* variance) {
-    const int W = test.width(), H = test.height();
+const std::vector<std::string>& regionNames() {
+    static const std::vector<std::string> names = {"background", "mixed", "edge", "penumbra", "defocused", "interior"};
+    return names;
+}
+
+Image<uint8_t> regionClasses(const RegionPlanes& planes, int edgeRadius) {
     const Image1f& object = planes.object;
     const Image1f& coverage = planes.coverage;
-    const Image1f e = relativeErrorMap(test, reference, eps);
-    std::vector<RegionError> r = {{"background"}, {"mixed"}, {"edge"}, {"penumbra"}, {"defocused"}, {"interior"}};
+    const int W = object.width(), H = object.height();
+    Image<uint8_t> classes(W, H);
     auto mixed = [&](size_t i) { return object[i] >= 0 && coverage[i] < kFullCoverage; };
-    double total = 0;
     for (int y = 0; y < H; ++y)
         for (int x = 0; x < W; ++x) {
             const size_t i = size_t(y) * W + x;
@@ -136,12 +138,27 @@ std::vector<RegionError> regionErrors(const Image3f& test, const Image3f& refere
                 const float occ = planes.occluded[i];
                 k = near ? 2 : (occ > 0.f && occ < 1.f) ? 3 : planes.defocus[i] > 1.f ? 4 : 5;
             }
-            r[k].pixels += 1;
-            r[k].share += e[i];
-            if (variance) r[k].variance += (*variance)[i];
-            total += e[i];
+            classes[i] = uint8_t(k);
         }
-    const double n = double(W) * double(H);
+    return classes;
+}
+
+std::vector<RegionError> regionErrors(const Image3f& test, const Image3f& reference, const Image<uint8_t>& classes,
+                                      float eps, const Image1f* variance) {
+    if (!classes.sameSize(test) || !test.sameSize(reference) || (variance && !variance->sameSize(test)))
+        throw Error("regions", "the pixel classes, the images and the variance map differ in size");
+    const Image1f e = relativeErrorMap(test, reference, eps);
+    std::vector<RegionError> r;
+    for (const auto& name : regionNames()) r.push_back({name});
+    double total = 0;
+    for (size_t i = 0; i < classes.size(); ++i) {
+        RegionError& c = r[classes[i]];
+        c.pixels += 1;
+        c.share += e[i];
+        if (variance) c.variance += (*variance)[i];
+        total += e[i];
+    }
+    const double n = double(classes.size());
     for (auto& c : r) {
         c.relMse = c.pixels > 0 ? c.share / c.pixels : 0.0;
         c.variance = c.pixels > 0 ? c.variance / c.pixels : 0.0;
@@ -149,6 +166,11 @@ std::vector<RegionError> regionErrors(const Image3f& test, const Image3f& refere
         c.pixels = n > 0 ? c.pixels / n : 0.0;
     }
     return r;
+}
+
+std::vector<RegionError> regionErrors(const Image3f& test, const Image3f& reference, const RegionPlanes& planes,
+                                      int edgeRadius, float eps, const Image1f* variance) {
+    return regionErrors(test, reference, regionClasses(planes, edgeRadius), eps, variance);
 }
 
 double smape(const Image3f& test, const Image3f& reference, float eps) {

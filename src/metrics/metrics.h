@@ -94,6 +94,14 @@ struct RegionPlanes {
 std::vector<RegionError> regionErrors(const Image3f& test, const Image3f& reference, const RegionPlanes& planes,
                                       int edgeRadius = 2, float eps = kRelMseEpsilon,
                                       const Image1f* variance = nullptr);
+/// The class names in index order ("background", ..., "interior").
+const std::vector<std::string>& regionNames();
+/// Each pixel's class (an index into regionNames()), from a render's planes: the first half of
+/// regionErrors(), so that a render's classes can be kept without its planes.
+Image<uint8_t> regionClasses(const RegionPlanes& planes, int edgeRadius = 2);
+/// The second half: the split over classes from regionClasses(). Throws Error on size mismatch.
+std::vector<RegionError> regionErrors(const Image3f& test, const Image3f& reference, const Image<uint8_t>& classes,
+                                      float eps = kRelMseEpsilon, const Image1f* variance = nullptr);
 
 struct Metrics {
     double relMse = 0, smape = 0, psnr = 0, ssim = 0;

@@ -138,8 +138,8 @@ private:
     double netRelMse(const ExperimentProbe& p) const { return p.metrics.relMse - m_result.referenceNoise; }
     /// The squared bias of a base row: its net relMSE minus its variance.
     double bias2(const ExperimentRow& r) const { return netRelMse(r.probe) - r.variance; }
-    /// The variance part of a base row's relMSE: the method rendered again with another seed.
-    double measureVariance(const std::string& method, const ExperimentProbe& p);
+    /// The variance part of a base row's relMSE, per pixel: the method rendered again with another seed.
+    Image1f measureVariance(const std::string& method, const ExperimentProbe& p);
     /// The options of one render: the base options with this method, spp and seed.
     RenderOptions renderOptions(const std::string& method, int spp, uint32_t seed, bool quiet) const {
         RenderOptions o = m_options.base;
@@ -242,6 +242,8 @@ const ExperimentProbe* Experiment::evaluate(const std::string& method, int spp) 
     p.sppAverage = r.sppAverage;
     p.seconds = r.seconds;
     p.metrics = metrics::compare(r.color, m_reference);
+    const FrameBuffers& fb = r.buffers;
+    p.regions = metrics::regionClasses({fb.object, fb.coverage, fb.defocus, fb.occluded});
     p.color = std::move(r.color);
     ++m_renders;
     say(format("[%.0f] ", m_renders) + method + " " + std::to_string(spp) + " spp: relMSE " +
@@ -249,10 +251,10 @@ const ExperimentProbe* Experiment::evaluate(const std::string& method, int spp) 
     return &memo.emplace(spp, std::move(p)).first->second;
 }
 
-double Experiment::measureVariance(const std::string& method, const ExperimentProbe& p) {
+Image1f Experiment::measureVariance(const std::string& method, const ExperimentProbe& p) {
     // Another seed, independent of the base render's samples.
     const RenderOptions o = renderOptions(method, p.spp, hashCombine(m_result.seed, 0x76617232U), true);
-    return metrics::seedVariance(p.color, render(m_scene, o).color, m_reference);
+    return metrics::seedVarianceMap(p.color, render(m_scene, o).color, m_reference);
 }
 
 void Experiment::searchEqualQuality(const std::string& method, double target) {
@@ -337,7 +339,9 @@ ExperimentResult Experiment::run() {
         row.method = m;
         row.setting = "base";
         row.probe = *p;
-        row.variance = measureVariance(m, *p);
+        const Image1f variance = measureVariance(m, *p);
+        row.variance = metrics::mapMean(variance);
+        row.regions = metrics::regionErrors(p->color, m_reference, p->regions, metrics::kRelMseEpsilon, &variance);
         say(m + " " + std::to_string(p->spp) + " spp with another seed: variance " + format("%.4g", row.variance) +
             ", squared bias " + format("%.4g", bias2(row)));
         m_result.rows.push_back(std::move(row));
@@ -481,6 +485,12 @@ void Experiment::writeResultsJson() const {
             j["variance_relmse"] = row.variance;
             j["bias2_relmse"] = bias2(row);
         }
+        if (!row.regions.empty()) {
+            nlohmann::json r = nlohmann::json::object();
+            for (const auto& c : row.regions)
+                r[c.name] = {{"pixels", c.pixels}, {"share", c.share}, {"relmse", c.relMse}, {"variance", c.variance}};
+            j["regions"] = r;
+        }
         j["overhead"] = overhead(row.probe.seconds);
         j["scene"] = m_result.scene;
         j["resolution"] = {m_result.width, m_result.height};
@@ -576,6 +586,28 @@ std::string Experiment::markdownTable() const {
         os << ".";
     }
     os << "\n";
+    // Where the error sits: the base rows' relMSE and variance over their renders' pixel classes.
+    if (anchor && !anchor->regions.empty()) {
+        const auto& names = metrics::regionNames();
+        os << "\n| where | ";
+        for (const auto& n : names) os << n << " | ";
+        os << "\n|---|";
+        for (size_t k = 0; k < names.size(); ++k) os << "---|";
+        os << "\n| pixels (" << m_result.anchor << ") | ";
+        for (const auto& c : anchor->regions) os << format("%.1f%%", 100 * c.pixels) << " | ";
+        os << "\n";
+        for (const auto& r : m_result.rows) {
+            if (r.setting != "base" || r.regions.empty()) continue;
+            os << "| " << r.method << " | ";
+            for (const auto& c : r.regions)
+                os << (c.pixels > 0 ? format("%.3g", c.relMse) + ", " + format("%.3g", c.variance) : "-") << " | ";
+            os << "\n";
+        }
+        os << "\nWhere: relMSE, variance of each base render over its own pixel classes (`wedge compare --regions`): "
+              "background, mixed surfaces, edge (within 2 px of those or of another object), penumbra (some but not "
+              "all of the initial shadow rays blocked), defocused, interior. The relMSE here includes the "
+              "reference's own noise.\n";
+    }
     return os.str();
 }
 

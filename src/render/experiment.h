@@ -62,6 +62,7 @@ struct ExperimentProbe {
     StageTimes seconds;
     metrics::Metrics metrics;
     Image3f color;
+    Image<uint8_t> regions;  // each pixel's class (metrics::regionClasses) from the render's own planes
     bool retimed = false;  // the final re-timing of the rows has run
 };
 
@@ -74,6 +75,8 @@ struct ExperimentRow {
     // Base rows: the variance part of relMSE (from a render with another seed); the squared bias
     // is the net relMSE minus it. Negative: not measured (the other settings' rows).
     double variance = -1;
+    // Base rows: relMSE and variance split over the render's pixel classes (`wedge compare --regions`).
+    std::vector<metrics::RegionError> regions;
     // Searches: the target (relMSE or seconds), whether it was reached within the cap, and every
     // render the search made, in order.
     double target = 0;
