@@ -589,18 +589,18 @@ std::string Experiment::markdownTable() const {
     // Where the error sits: the base rows' relMSE and variance over their renders' pixel classes.
     if (anchor && !anchor->regions.empty()) {
         const auto& names = metrics::regionNames();
-        os << "\n| where | ";
-        for (const auto& n : names) os << n << " | ";
+        os << "\n| where |";
+        for (const auto& n : names) os << " " << n << " |";
         os << "\n|---|";
         for (size_t k = 0; k < names.size(); ++k) os << "---|";
-        os << "\n| pixels (" << m_result.anchor << ") | ";
-        for (const auto& c : anchor->regions) os << format("%.1f%%", 100 * c.pixels) << " | ";
+        os << "\n| pixels (" << m_result.anchor << ") |";
+        for (const auto& c : anchor->regions) os << " " << format("%.1f%%", 100 * c.pixels) << " |";
         os << "\n";
         for (const auto& r : m_result.rows) {
             if (r.setting != "base" || r.regions.empty()) continue;
-            os << "| " << r.method << " | ";
+            os << "| " << r.method << " |";
             for (const auto& c : r.regions)
-                os << (c.pixels > 0 ? format("%.3g", c.relMse) + ", " + format("%.3g", c.variance) : "-") << " | ";
+                os << " " << (c.pixels > 0 ? format("%.3g", c.relMse) + ", " + format("%.3g", c.variance) : "-") << " |";
             os << "\n";
         }
         os << "\nWhere: relMSE, variance of each base render over its own pixel classes (`wedge compare --regions`): "
