@@ -166,6 +166,8 @@ TEST(Metrics, RegionErrorsSplitTheErrorByPixelClass) {
         EXPECT_EQ(w[k].variance, v[k].variance);
     }
     EXPECT_THROW(regionErrors(test, ref, Image<uint8_t>(4, 4), 0.f), Error);
+    const Image1f small(4, 4);
+    EXPECT_THROW(regionClasses({object, coverage, defocus, small}), Error);
 }
 
 TEST(Metrics, SeedVarianceSplitsNoiseFromBias) {

@@ -118,6 +118,8 @@ Image<uint8_t> regionClasses(const RegionPlanes& planes, int edgeRadius) {
     const Image1f& object = planes.object;
     const Image1f& coverage = planes.coverage;
     const int W = object.width(), H = object.height();
+    if (!coverage.sameSize(object) || !planes.defocus.sameSize(object) || !planes.occluded.sameSize(object))
+        throw Error("regions", "the object, coverage, defocus and occluded planes differ in size");
     Image<uint8_t> classes(W, H);
     auto mixed = [&](size_t i) { return object[i] >= 0 && coverage[i] < kFullCoverage; };
     for (int y = 0; y < H; ++y)
