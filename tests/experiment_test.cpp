@@ -163,6 +163,7 @@ TEST(ExperimentCommand, WritesRowsAndASelfContainedReport) {
     EXPECT_NE(html.find("its own noise"), std::string::npos);
     EXPECT_NE(html.find("net relMSE"), std::string::npos);
     EXPECT_NE(html.find("bias&sup2;"), std::string::npos);
+    EXPECT_NE(html.find("Where the error sits"), std::string::npos);
     EXPECT_TRUE(fs::is_regular_file(dir + "/table.md"));
     const std::string table = slurp(dir + "/table.md");
     EXPECT_NE(table.find("| where | background | mixed | edge | penumbra | defocused | interior |"), std::string::npos)

@@ -710,6 +710,25 @@ void Experiment::writeHtml() const {
          "with another seed (base rows), bias&sup2; = net relMSE &minus; variance. PSNR and SSIM "
          "(11&times;11 Gaussian, &sigma; 1.5) on tone-mapped images (clamp, sRGB).</p>\n";
 
+    // Where the error sits: the base rows over their renders' pixel classes.
+    if (anchor && !anchor->regions.empty()) {
+        h << "<h2>Where the error sits</h2>\n<table><tr><th>method</th>";
+        for (const auto& n : metrics::regionNames()) h << "<th>" << n << "</th>";
+        h << "</tr>\n<tr>" << td("pixels (" + htmlEscape(m_result.anchor) + ")");
+        for (const auto& c : anchor->regions) h << td(format("%.1f%%", 100 * c.pixels));
+        h << "</tr>\n";
+        for (const auto& r : m_result.rows) {
+            if (r.setting != "base" || r.regions.empty()) continue;
+            h << "<tr>" << td(htmlEscape(r.method));
+            for (const auto& c : r.regions)
+                h << td(c.pixels > 0 ? format("%.3g", c.relMse) + ", " + format("%.3g", c.variance) : "-");
+            h << "</tr>\n";
+        }
+        h << "</table>\n<p>relMSE, variance of each base render over its own pixel classes (as <code>wedge compare "
+             "--regions</code>): mixed surfaces, edge (within 2 px of those or of another object), penumbra (some "
+             "but not all of the initial shadow rays blocked), defocused, interior.</p>\n";
+    }
+
     // Images side by side, with insets and heat maps.
     auto boxes = [&]() {
         std::string s;
