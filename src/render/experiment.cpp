@@ -35,6 +35,14 @@ std::string format(const char* fmt, double v) {
 
 std::string seconds(double s) { return s >= 10 ? format("%.1f s", s) : format("%.3f s", s); }
 
+/// The "where" tables (Markdown and HTML): one class's cell, and what the classes are.
+std::string regionCell(const metrics::RegionError& c) {
+    return c.pixels > 0 ? format("%.3g", c.relMse) + ", " + format("%.3g", c.variance) : "-";
+}
+constexpr const char* kRegionLegend =
+    "background, mixed surfaces, edge (within 2 px of those or of another object), penumbra (some but not all of "
+    "the initial shadow rays blocked), defocused, interior";
+
 /// Scene name usable in file names.
 std::string fileStem(const std::string& name) {
     std::string stem = fs::path(name).stem().string();
@@ -242,8 +250,10 @@ const ExperimentProbe* Experiment::evaluate(const std::string& method, int spp) 
     p.sppAverage = r.sppAverage;
     p.seconds = r.seconds;
     p.metrics = metrics::compare(r.color, m_reference);
-    const FrameBuffers& fb = r.buffers;
-    p.regions = metrics::regionClasses({fb.object, fb.coverage, fb.defocus, fb.occluded});
+    if (spp == m_options.spp) {  // the base rows' probes: only they are split over pixel classes
+        const FrameBuffers& fb = r.buffers;
+        p.regions = metrics::regionClasses({fb.object, fb.coverage, fb.defocus, fb.occluded});
+    }
     p.color = std::move(r.color);
     ++m_renders;
     say(format("[%.0f] ", m_renders) + method + " " + std::to_string(spp) + " spp: relMSE " +
@@ -599,14 +609,11 @@ std::string Experiment::markdownTable() const {
         for (const auto& r : m_result.rows) {
             if (r.setting != "base" || r.regions.empty()) continue;
             os << "| " << r.method << " |";
-            for (const auto& c : r.regions)
-                os << " " << (c.pixels > 0 ? format("%.3g", c.relMse) + ", " + format("%.3g", c.variance) : "-") << " |";
+            for (const auto& c : r.regions) os << " " << regionCell(c) << " |";
             os << "\n";
         }
         os << "\nWhere: relMSE, variance of each base render over its own pixel classes (`wedge compare --regions`): "
-              "background, mixed surfaces, edge (within 2 px of those or of another object), penumbra (some but not "
-              "all of the initial shadow rays blocked), defocused, interior. The relMSE here includes the "
-              "reference's own noise.\n";
+           << kRegionLegend << ". The relMSE here includes the reference's own noise.\n";
     }
     return os.str();
 }
@@ -720,13 +727,12 @@ void Experiment::writeHtml() const {
         for (const auto& r : m_result.rows) {
             if (r.setting != "base" || r.regions.empty()) continue;
             h << "<tr>" << td(htmlEscape(r.method));
-            for (const auto& c : r.regions)
-                h << td(c.pixels > 0 ? format("%.3g", c.relMse) + ", " + format("%.3g", c.variance) : "-");
+            for (const auto& c : r.regions) h << td(regionCell(c));
             h << "</tr>\n";
         }
         h << "</table>\n<p>relMSE, variance of each base render over its own pixel classes (as <code>wedge compare "
-             "--regions</code>): mixed surfaces, edge (within 2 px of those or of another object), penumbra (some "
-             "but not all of the initial shadow rays blocked), defocused, interior.</p>\n";
+             "--regions</code>): "
+          << kRegionLegend << ". The relMSE here includes the reference's own noise.</p>\n";
     }
 
     // Images side by side, with insets and heat maps.
