@@ -5,6 +5,7 @@
 #include <filesystem>
 
 #include "core/error.h"
+#include "core/image.h"
 #include "core/sampler.h"
 #include "io/image_io.h"
 #include "test_util.h"
@@ -98,6 +99,45 @@ TEST(Sampler, DependsOnlyOnSeedPixelIndexAndPair) {
     EXPECT_NE(a.get2D(7, 2).x, d.get2D(7, 2).x);
     EXPECT_NE(a.get2D(7, 2).x, a.get2D(7, 3).x);
     EXPECT_EQ(reverseBits32(sobol1Reversed(12345)), sobol1(12345));
+}
+
+TEST(Image, FillsAndCopiesEveryPixelOverReusedMemory) {
+    // Image leaves implicit-lifetime pixels unwritten until its parallel fill (UnwrittenAllocator):
+    // every pixel must still hold the fill value, also where the allocator hands back memory a
+    // freed image had written, and for types whose default member initialisers are the only
+    // initialisation they get (Vec3f, a struct with an infinity in it).
+    struct Px {
+        float a = 1.f, b = kInf;
+        uint32_t n = 7;
+    };
+    for (int round = 0; round < 3; ++round) {
+        {
+            Image3f dirty(1500, 1100, Vec3f(-5.f));  // over 2 MiB: the large-block path
+            Image<Px> dirtyPx(700, 900, Px{-1.f, -1.f, 99});
+        }
+        Image3f zero(1500, 1100);
+        Image<Px> px(700, 900);
+        Image1f seven(33, 17, 7.f);  // below 2 MiB: malloc's path
+        for (size_t i = 0; i < zero.size(); ++i) ASSERT_EQ(zero[i].x + zero[i].y + zero[i].z, 0.f) << i;
+        for (size_t i = 0; i < px.size(); ++i) {
+            ASSERT_EQ(px[i].a, 1.f) << i;
+            ASSERT_EQ(px[i].b, kInf) << i;
+            ASSERT_EQ(px[i].n, 7u) << i;
+        }
+        for (size_t i = 0; i < seven.size(); ++i) ASSERT_EQ(seven[i], 7.f);
+        // Copies (parallel) equal their source, and assignment replaces the size too.
+        px[12345].n = 3;
+        Image<Px> copy(px);
+        ASSERT_EQ(copy.width(), 700);
+        ASSERT_EQ(copy.height(), 900);
+        for (size_t i = 0; i < px.size(); ++i) ASSERT_EQ(copy[i].n, px[i].n) << i;
+        Image<Px> assigned(3, 3);
+        assigned = copy;
+        EXPECT_EQ(assigned.width(), 700);
+        EXPECT_EQ(assigned[12345].n, 3u);
+        assigned = assigned;  // self-assignment keeps the pixels
+        EXPECT_EQ(assigned[12345].n, 3u);
+    }
 }
 
 TEST(ImageIo, RoundTrips) {

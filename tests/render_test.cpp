@@ -280,16 +280,16 @@ TEST(Render, SamplesTracedAgainAreTheSamplesAndFindTheirSlot) {
 }
 
 TEST(Render, MaafTracingAgainGivesTheImageOfTheRecords) {
-    // --maaf-retrace: the outer-component pixels' initial samples traced again instead of kept
-    // give the same image bit for bit (all components everywhere, so that most pixels use them).
+    // The outer-component pixels' initial samples traced again (the default) give the image of
+    // --maaf-keep-records bit for bit (all components everywhere, so that most pixels use them).
     scene::Scene s(parse(kPlankUnderLens));
     render::RenderOptions o;
     o.quiet = true;
     o.method = "maaf";
     o.maafFit = false;
-    o.maafRetrace = false;
+    o.maafKeepRecords = true;
     render::RenderResult kept = render::render(s, o);
-    o.maafRetrace = true;
+    o.maafKeepRecords = false;
     render::RenderResult traced = render::render(s, o);
     EXPECT_EQ(kept.figure("maaf_retrace"), 0.0);
     EXPECT_EQ(traced.figure("maaf_retrace"), 1.0);

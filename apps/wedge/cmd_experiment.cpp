@@ -106,9 +106,8 @@ void registerExperiment(CLI::App& app) {
     cmd->add_option("--maaf-radius", r.maafRadius, "maaf: spatial filter window in pixels (default 10)")
         ->check(CLI::Range(1, filter::kMaafMaxWindowRadius));
     cmd->add_flag("!--no-maaf-fit", r.maafFit, "maaf: all components everywhere, also where the window cannot hold them");
-    cmd->add_flag_function(
-        "--maaf-retrace", [args](int64_t) { args->options.base.maafRetrace = true; },
-        "maaf: trace the outer-component pixels' initial samples again instead of keeping every pixel's (less memory)");
+    cmd->add_flag("--maaf-keep-records", r.maafKeepRecords,
+                  "maaf: keep every pixel's initial samples instead of tracing the outer-component pixels' again");
     cmd->add_option("--maaf-weights", r.maafWeights, "maaf: component weights mu_p (sampling, eq10 or unit)")
         ->check(CLI::IsMember({"sampling", "eq10", "unit"}));
     cmd->add_option("--atrous-iterations", r.atrousIterations, "atrous: wavelet levels")->check(CLI::Range(1, 10));

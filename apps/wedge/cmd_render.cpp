@@ -80,10 +80,9 @@ void registerRender(CLI::App& app) {
         ->check(CLI::Range(1, filter::kMaafMaxWindowRadius));
     cmd->add_flag("!--no-maaf-fit", args->options.maafFit,
                   "maaf: all components everywhere, also where the window cannot hold them (the paper's configuration)");
-    cmd->add_flag_function(
-        "--maaf-retrace", [args](int64_t) { args->options.maafRetrace = true; },
-        "maaf: trace the outer-component pixels' initial samples again instead of keeping every pixel's (less memory; "
-        "the default when those records would take over a quarter of the available memory)");
+    cmd->add_flag("--maaf-keep-records", args->options.maafKeepRecords,
+                  "maaf: keep every pixel's initial samples instead of tracing the outer-component pixels' again "
+                  "(the same image; more memory, faster only where the memory was touched before)");
     cmd->add_option("--maaf-weights", args->options.maafWeights,
                     "maaf: component weights mu_p: the sampling densities' spectra (default), eq. 10's Gaussian, or 1")
         ->check(CLI::IsMember({"sampling", "eq10", "unit"}));

@@ -10,8 +10,9 @@ FrameBuffers::FrameBuffers(int w, int h)
       directUnoccluded(w, h), visibility(w, h), unoccluded(w, h), d1(w, h), sMax(w, h), sMin(w, h),
       occluded(w, h), zMin(w, h), zMax(w, h), bounced(w, h), suMin(w, h), suMax(w, h), defocus(w, h), footprint(w, h) {
     for (OtherSurface& o : other) {
-        o.albedo = o.normal = o.position = o.direct = o.indirect = Image3f(w, h);
-        o.object = o.coverage = Image1f(w, h);
+        // Each constructed, not copied: a copy is another pass over fresh pages.
+        for (Image3f* plane : {&o.albedo, &o.normal, &o.position, &o.direct, &o.indirect}) *plane = Image3f(w, h);
+        for (Image1f* plane : {&o.object, &o.coverage}) *plane = Image1f(w, h);
     }
 }
 

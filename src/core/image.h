@@ -29,14 +29,22 @@ public:
         m_data.resize(size_t(width) * height);
     }
     Image(int width, int height, const T& fill = T{}) : m_width(width), m_height(height) {
-        // Default-initialised storage filled in parallel: the first touch of the pages (and the
-        // kernel's zeroing of them) is spread over the worker threads.
+        // Unwritten storage (UnwrittenAllocator) filled in parallel: the first touch of the pages
+        // (and the kernel's zeroing of them) is spread over the worker threads.
         m_data.resize(size_t(width) * height);
-        const size_t n = m_data.size();
-        tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 1 << 16), [&](const tbb::blocked_range<size_t>& r) {
-            std::fill(m_data.begin() + r.begin(), m_data.begin() + r.end(), fill);
-        });
+        parallelRange([&](size_t a, size_t b) { std::fill(m_data.begin() + a, m_data.begin() + b, fill); });
     }
+    // Copies likewise: a vector's copy would first-touch every page on one thread.
+    Image(const Image& o) : m_width(o.m_width), m_height(o.m_height) {
+        m_data.resize(o.m_data.size());
+        parallelRange([&](size_t a, size_t b) { std::copy(o.m_data.begin() + a, o.m_data.begin() + b, m_data.begin() + a); });
+    }
+    Image& operator=(const Image& o) {
+        if (this != &o) *this = Image(o);
+        return *this;
+    }
+    Image(Image&&) noexcept = default;
+    Image& operator=(Image&&) noexcept = default;
 
     int width() const { return m_width; }
     int height() const { return m_height; }
@@ -63,8 +71,14 @@ public:
     bool sameSize(const Image<U>& o) const { return m_width == o.width() && m_height == o.height(); }
 
 private:
+    template <class Fn>
+    void parallelRange(Fn&& fn) {
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, m_data.size(), 1 << 16),
+                          [&](const tbb::blocked_range<size_t>& r) { fn(r.begin(), r.end()); });
+    }
+
     int m_width = 0, m_height = 0;
-    LargeVector<T> m_data;
+    std::vector<T, UnwrittenAllocator<T>> m_data;
 };
 
 using Image1f = Image<float>;

@@ -269,7 +269,7 @@ void MaafSample::coordinates(const ViewGeometry& view, const AxisFrame& direct, 
 }
 
 MaafAccumulator::MaafAccumulator(const MaafEffect& params, int pairs, int values)
-    : m_width(params.width()), m_height(params.height()), m_pairs(pairs), m_maxBands(2 * pairs - 1), m_values(values),
+    : m_width(params.width()), m_height(params.height()), m_pairs(pairs), m_values(values),
       m_channels(values + 1) {
     const size_t n = size_t(params.width()) * params.height();
     m_bands1.resize(n);
@@ -394,11 +394,26 @@ struct Window {
 
 Image3f MaafAccumulator::filter(const MaafEffect& params, const FrameBuffers& fb, const Image<AxisFrame>& frames,
                                 const Image3f& fallback, const MaafOptions& o) const {
-    const int W = m_width, H = m_height, B = m_maxBands, C = m_channels, V = m_values;
-    const size_t istride = size_t(B + 1) * C;  // B bands of axis 2, plus the central-only band
-    LargeVector<float> inter(size_t(W) * H * istride);  // default-initialised: zeroed by the rows in parallel
+    const int W = m_width, H = m_height, C = m_channels, V = m_values;
+    // Pass 1's output at a pixel: the axis-2 bands its row neighbours accumulated, at most as many
+    // as the most any pixel within the widest window has (1 in most of an image), plus the
+    // central-only band. A fixed (2N-1) + 1 bands per pixel would be 38 MB at 512x512, mostly zeros.
+    const int reach = std::min(o.maxRadius, kMaafMaxWindowRadius);
+    LargeVector<uint8_t> interBands(size_t(W) * H);
     parallelRows(H, [&](int y) {
-        std::fill(inter.begin() + size_t(y) * W * istride, inter.begin() + size_t(y + 1) * W * istride, 0.f);
+        for (int x = 0; x < W; ++x) {
+            uint8_t b = 1;
+            for (int xx = std::max(0, x - reach); xx <= std::min(W - 1, x + reach); ++xx)
+                b = std::max(b, m_bands2[size_t(y) * W + xx]);
+            interBands[size_t(y) * W + x] = b;
+        }
+    });
+    LargeVector<size_t> interOffset(size_t(W) * H + 1);
+    interOffset[0] = 0;
+    for (size_t p = 0; p < size_t(W) * H; ++p) interOffset[p + 1] = interOffset[p] + size_t(interBands[p] + 1) * C;
+    LargeVector<float> inter(interOffset.back());  // default-initialised: zeroed by the rows in parallel
+    parallelRows(H, [&](int y) {
+        std::fill(inter.begin() + interOffset[size_t(y) * W], inter.begin() + interOffset[size_t(y + 1) * W], 0.f);
     });
 
     // Pass 1 along image x: sum over the components p of axis 1 (eq. 21).
@@ -408,7 +423,8 @@ Image3f MaafAccumulator::filter(const MaafEffect& params, const FrameBuffers& fb
             if (fb.object[p] < 0) continue;
             const MaafAxis ax = params.axis(p, 0);
             const AxisFrame& f = frames[p];
-            float* out = &inter[p * istride];
+            float* out = &inter[interOffset[p]];
+            const int B = interBands[p];  // the central-only band follows the B bands
             const Window win(fb, params, ax, f, x, y, 0, o);
             const int radius = win.radius;
             for (int k = -radius; k <= radius; ++k) {
@@ -459,8 +475,9 @@ Image3f MaafAccumulator::filter(const MaafEffect& params, const FrameBuffers& fb
                 bool mirror = !o.symmetricOuter || win.ok[radius - k];
                 size_t q = size_t(y + k) * W + x;
                 float a = win.a[k + radius], r = win.r[k + radius];
-                const float* I = &inter[q * istride];
-                for (int c = 0; c < (mirror ? ax.pairs : 1); ++c) {
+                const float* I = &inter[interOffset[q]];
+                const int B = interBands[q];  // bands beyond B are zero
+                for (int c = 0; c < (mirror ? ax.pairs : 1) && 2 * c < B; ++c) {
                     float sr = ax.sx[c] * r;
                     float g = ax.weight[c] * ax.sx[c] * kInvSqrt2Pi * std::exp(-0.5f * sr * sr);
                     if (c == 0) {

@@ -208,7 +208,7 @@ public:
                    const Image3f& fallback, const MaafOptions& options) const;
 
 private:
-    int m_width, m_height, m_pairs, m_maxBands, m_values, m_channels;
+    int m_width, m_height, m_pairs, m_values, m_channels;
     LargeVector<uint8_t> m_bands1, m_bands2;
     LargeVector<size_t> m_offset;
     LargeVector<float> m_data;

@@ -74,18 +74,16 @@ void renderMaaf(const MethodContext& ctx, RenderResult& result) {
                                              " initial spp, but only " + std::to_string(avail >> 20) + " MiB are available");
     };
     // The pixels with outer components need their initial samples one by one, and which pixels
-    // those are is known only after the prefilter. Either every pixel's initial samples are kept
-    // as 36-byte records, or those pixels' samples are traced again after the prefilter (the
-    // sampler is deterministic per pixel and sample index; bit-identical images). Records are
-    // faster where memory has been touched before (an experiment's repeated renders: conference
-    // 512x512 1.80-1.83 s against 1.88-1.89 s) and the same in a fresh process; tracing again
-    // needs 151 MB less at 512x512, 299 MB less at 720x720 (README, "MAAF's sample records").
-    // By default records, unless they would take more than a quarter of the available memory or
-    // would not fit beside the rest.
+    // those are is known only after the prefilter. By default those pixels' initial samples are
+    // traced again after the prefilter (the sampler is deterministic per pixel and sample index;
+    // bit-identical images); --maaf-keep-records keeps a 36-byte record of every pixel's initial
+    // samples instead (151 MB at 512x512, 299 MB at 720x720). Memory first touched is what costs
+    // here: in fresh processes started 4 s apart (so that the pages freed before had gone back to
+    // the hypervisor), tracing again was faster on five of the six 512x512 scenes (cornell 3.0-3.2 s
+    // against 3.5 s, bunny 3.6-3.7 s against 4.0-4.6 s) and level on sponza (8.1 s against
+    // 7.4-8.0 s), with 125 MB less at the peak (README, "MAAF's sample records").
+    const bool retrace = !ctx.options.maafKeepRecords;
     const size_t initialRecordBytes = pixels * n0 * sizeof(filter::MaafSample);
-    const size_t avail = availableMemory();
-    const bool retrace = ctx.options.maafRetrace.value_or(
-        avail > 0 && (initialRecordBytes > avail / 4 || accBytes + otherBytes + initialRecordBytes > avail));
     checkMemory(accBytes + otherBytes + (retrace ? 0 : initialRecordBytes),
                 retrace ? "accumulations and pixel statistics" : "accumulations, pixel statistics and sample records");
     result.extra.emplace_back("maaf_components", double(2 * mo.pairs - 1));
@@ -162,10 +160,12 @@ void renderMaaf(const MethodContext& ctx, RenderResult& result) {
                params.indirect.pairs(p, 0) > 1 || params.indirect.pairs(p, 1) > 1;
     };
 
-    // Records of every sample of the pixels with outer components (4-19% of the pixels in the
-    // 512x512 scenes): their adaptive samples as they are taken, their initial samples below.
+    // Records of the pixels with outer components (4-19% of the pixels in the 512x512 scenes):
+    // their adaptive samples as they are taken, and their initial samples traced again below
+    // when the initial records were not kept (those are read where they are).
+    const uint32_t again = retrace ? n0 : 0;  // initial samples per outer pixel in `records`
     std::vector<uint64_t> offset(pixels + 1, 0);
-    for (size_t i = 0; i < pixels; ++i) offset[i + 1] = offset[i] + (outer(i) ? n0 + extra[i] : 0);
+    for (size_t i = 0; i < pixels; ++i) offset[i + 1] = offset[i] + (outer(i) ? again + extra[i] : 0);
     checkMemory(offset[pixels] * sizeof(filter::MaafSample), "sample records of the pixels with outer components");
     LargeVector<filter::MaafSample> records(offset[pixels]);
     result.extra.emplace_back("maaf_sample_record_bytes", double(records.size() * sizeof(filter::MaafSample)));
@@ -180,7 +180,7 @@ void renderMaaf(const MethodContext& ctx, RenderResult& result) {
             ctx.sampler, stats, view, [&](int x, int y) { return SampleRange{n0, extra(x, y)}; }, false, false,
             [&](int x, int y, const TracedSample& s, int slot) {
                 size_t p = size_t(y) * W + x;
-                if (offset[p + 1] > offset[p]) records[offset[p] + n0 + fill[p]++] = filter::MaafSample::pack(s.record, view, slot);
+                if (outer(p)) records[offset[p] + again + fill[p]++] = filter::MaafSample::pack(s.record, view, slot);
             },
             &progress);
     }
@@ -188,20 +188,16 @@ void renderMaaf(const MethodContext& ctx, RenderResult& result) {
     result.rays += denseEmission(ctx, emitterExtra, fb);
     result.seconds.add("sampling_adaptive", t.seconds());
 
-    // 3b. The initial samples of the pixels with outer components: from the records, or traced
-    // again (PixelStats::slotOf finds the surface each one went to; tests/render_test.cpp).
+    // 3b. Without the initial records, the initial samples of the pixels with outer components
+    // traced again (PixelStats::slotOf finds the surface each one went to; tests/render_test.cpp).
     t.reset();
     std::atomic<uint64_t> retracedRays{0};
-    parallelRows(H, [&](int y) {
+    if (retrace) parallelRows(H, [&](int y) {
         uint64_t rays = 0;
         TracedSample batch[16];
         for (int x = 0; x < W; ++x) {
             const size_t p = size_t(y) * W + x;
-            if (offset[p + 1] == offset[p]) continue;
-            if (!retrace) {
-                std::copy_n(&initial[p * n0], n0, &records[offset[p]]);
-                continue;
-            }
+            if (!outer(p)) continue;
             for (uint32_t first = 0; first < n0; first += 16) {
                 const uint32_t n = std::min<uint32_t>(16, n0 - first);
                 ctx.sampler.traceBatch(x, y, first, n, false, batch);
@@ -213,15 +209,13 @@ void renderMaaf(const MethodContext& ctx, RenderResult& result) {
         }
         retracedRays += rays;
     });
-    LargeVector<filter::MaafSample>().swap(initial);  // (= {} would keep the capacity)
     result.rays += retracedRays;
-    const double gather = t.seconds();
-    if (retrace) result.seconds.add("sampling_retrace", gather);
+    if (retrace) result.seconds.add("sampling_retrace", t.seconds());
     result.seconds.add("sampling", result.seconds.get("sampling_initial") + result.seconds.get("sampling_adaptive") +
-                                       (retrace ? gather : 0.0));
+                                       result.seconds.get("sampling_retrace"));
 
-    // 2b. Accumulation of eq. 23 over the samples on each pixel's primary surface, as means
-    // (with the records' copy above when they were kept).
+    // 2b. Accumulation of eq. 23 over the samples on each pixel's primary surface, as means:
+    // the initial samples from their records (or traced again), then the adaptive ones.
     t.reset();
     filter::MaafAccumulator accDirect(params.direct, mo.pairs, 1), accIndirect(params.indirect, mo.pairs, 3);
     result.extra.emplace_back("maaf_accumulator_bytes", double(accDirect.allocatedBytes() + accIndirect.allocatedBytes()));
@@ -256,6 +250,8 @@ void renderMaaf(const MethodContext& ctx, RenderResult& result) {
                 accIndirect.add(p, m.indirect, 1.f, yIndirect, u, indirect);
                 ++counted;
             };
+            if (!retrace)
+                for (uint32_t i = 0; i < n0; ++i) accumulate(initial[p * n0 + i]);
             for (uint64_t i = offset[p]; i < offset[p + 1]; ++i) accumulate(records[i]);
             if (counted > 0) {
                 accDirect.scale(p, 1.f / float(counted));
@@ -266,10 +262,11 @@ void renderMaaf(const MethodContext& ctx, RenderResult& result) {
     });
     // Free what the filter no longer needs before it allocates its buffers: a lower peak and
     // fewer freshly touched pages.
-    LargeVector<filter::MaafSample>().swap(records);  // (= {} would keep the capacity)
+    LargeVector<filter::MaafSample>().swap(initial);  // (= {} would keep the capacity)
+    LargeVector<filter::MaafSample>().swap(records);
     stats = Image<PixelStats>();
     result.extra.emplace_back("maaf_outer_component_pixels", double(outerPixels));
-    result.seconds.add("prefilter_accumulation", (retrace ? 0.0 : gather) + t.seconds());
+    result.seconds.add("prefilter_accumulation", t.seconds());
     result.seconds.add("prefilter",
                        result.seconds.get("prefilter_slopes") + result.seconds.get("prefilter_accumulation"));
 

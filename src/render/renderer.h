@@ -30,10 +30,9 @@ struct RenderOptions {
     bool maafWindows = false;        // eq. 20's Gaussian windows over light and lens samples
     int maafRadius = 10;             // the spatial filter's window, pixels (NOTES: the reimplementation's 10)
     bool maafFit = true;             // only as many components per axis as that window resolves (filter/maaf.h)
-    // Trace the initial samples of the pixels with outer components again instead of keeping
-    // records of every pixel's initial samples (less memory; render/method_maaf.cpp). Default:
-    // only when those records would take more than a quarter of the available memory.
-    std::optional<bool> maafRetrace;
+    // Keep a record of every pixel's initial samples instead of tracing again the initial
+    // samples of the pixels with outer components (render/method_maaf.cpp: same image, more memory).
+    bool maafKeepRecords = false;
     std::string maafWeights = "sampling";  // mu_p: sampling | eq10 | unit (filter/maaf.h, "Weights")
     // à-trous
     int atrousIterations = 5;
