@@ -19,11 +19,12 @@ void renderAaf(const MethodContext& ctx, RenderResult& result) {
     const int W = view.width, H = view.height;
     const uint32_t n0 = uint32_t(ctx.spp);
     const int cap = std::max(ctx.options.maxExtraSpp, 0);
-    Image<PixelStats> stats(W, H);
     FrameBuffers& fb = result.buffers;
 
-    // 1. Initial sampling: occluder spans give the shadow slopes.
+    // 1. Initial sampling: occluder spans give the shadow slopes (the stage includes first
+    // touching the pixel statistics: 0.02-0.33 s at 512x512 on this machine).
     Timer t;
+    Image<PixelStats> stats(W, H);
     {
         Progress progress("aaf initial", uint64_t(W) * H * n0, !ctx.options.quiet);
         result.rays += samplePixels(

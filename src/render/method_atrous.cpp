@@ -8,8 +8,7 @@
 namespace wedge::render {
 
 void renderAtrous(const MethodContext& ctx, RenderResult& result) {
-    Image<PixelStats> stats(ctx.view.width, ctx.view.height);
-    sampleUniform(ctx, "atrous sampling", stats, result);
+    sampleUniform(ctx, "atrous sampling", result);
     filter::AtrousParams params;
     params.iterations = ctx.options.atrousIterations;
     params.sigmaColor = ctx.options.atrousSigmaColor;

@@ -91,12 +91,12 @@ void renderMaaf(const MethodContext& ctx, RenderResult& result) {
     result.extra.emplace_back("maaf_retrace", retrace ? 1.0 : 0.0);
     result.extra.emplace_back("maaf_initial_record_bytes", retrace ? 0.0 : double(initialRecordBytes));
 
+    // 1. Initial sampling: 16 path samples with occluder spans (the stage includes first
+    // touching the pixel statistics, as in AAF).
+    Timer t;
     Image<PixelStats> stats(W, H);
     FrameBuffers& fb = result.buffers;
     LargeVector<filter::MaafSample> initial(retrace ? 0 : pixels * n0);
-
-    // 1. Initial sampling: 16 path samples with occluder spans.
-    Timer t;
     {
         Progress progress("maaf initial", uint64_t(pixels) * n0, !ctx.options.quiet);
         std::vector<uint32_t> fill(retrace ? 0 : pixels, 0);

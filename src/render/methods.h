@@ -55,8 +55,9 @@ constexpr float kMixedTau = 0.01f;
 constexpr uint32_t kMixedSpp = 64;
 
 /// Monte Carlo sampling as `mc` does it: ctx.spp samples per pixel, then the emitter-edge
-/// top-up. Returns the number of rays; fills `stats` and result.buffers, times "sampling".
-void sampleUniform(const MethodContext& ctx, const std::string& label, Image<PixelStats>& stats, RenderResult& result);
+/// top-up, into pixel statistics of its own. Adds the rays to result.rays, fills result.buffers,
+/// and times "sampling" (the statistics' allocation included).
+void sampleUniform(const MethodContext& ctx, const std::string& label, RenderResult& result);
 
 /// Stores every pixel's statistics into `fb`, with the closed-form unoccluded direct light.
 void storeStats(const Image<PixelStats>& stats, const MethodContext& ctx, FrameBuffers& fb);

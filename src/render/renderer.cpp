@@ -90,9 +90,10 @@ double averageSpp(const FrameBuffers& fb) {
     return fb.spp.empty() ? 0 : s / double(fb.spp.size());
 }
 
-void sampleUniform(const MethodContext& ctx, const std::string& label, Image<PixelStats>& stats, RenderResult& result) {
+void sampleUniform(const MethodContext& ctx, const std::string& label, RenderResult& result) {
     const ViewGeometry& view = ctx.view;
-    Timer t;
+    Timer t;  // from the pixel statistics' allocation: first touching them is part of the stage
+    Image<PixelStats> stats(view.width, view.height);
     Progress progress(label, uint64_t(view.width) * view.height * ctx.spp, !ctx.options.quiet);
     result.rays += samplePixels(
         ctx.sampler, stats, view, [&](int, int) { return SampleRange{0, uint32_t(ctx.spp)}; }, false, true,
@@ -106,12 +107,12 @@ void sampleUniform(const MethodContext& ctx, const std::string& label, Image<Pix
         false, [](int, int, const TracedSample&, int) {}, nullptr);
     storeStats(stats, ctx, result.buffers);
     result.rays += denseEmission(ctx, topUp, result.buffers);
+    stats = Image<PixelStats>();
     result.seconds.add("sampling", t.seconds());
 }
 
 void renderMc(const MethodContext& ctx, RenderResult& result) {
-    Image<PixelStats> stats(ctx.view.width, ctx.view.height);
-    sampleUniform(ctx, "mc sampling", stats, result);
+    sampleUniform(ctx, "mc sampling", result);
     result.color = result.buffers.color;
 }
 
