@@ -81,7 +81,7 @@ void renderMaaf(const MethodContext& ctx, RenderResult& result) {
     // here: in fresh processes started 4 s apart (so that the pages freed before had gone back to
     // the hypervisor), tracing again was faster on five of the six 512x512 scenes (cornell 3.0-3.2 s
     // against 3.5 s, bunny 3.6-3.7 s against 4.0-4.6 s) and level on sponza (8.1 s against
-    // 7.4-8.0 s), with 125 MB less at the peak (README, "MAAF's sample records").
+    // 7.4-8.0 s), with 118-137 MB less at the peak (README, "MAAF's sample records").
     const bool retrace = !ctx.options.maafKeepRecords;
     const size_t initialRecordBytes = pixels * n0 * sizeof(filter::MaafSample);
     checkMemory(accBytes + otherBytes + (retrace ? 0 : initialRecordBytes),
