@@ -73,17 +73,12 @@ struct UnwrittenAllocator : LargeAllocator<T> {
     template <class U>
     UnwrittenAllocator(const UnwrittenAllocator<U>&) {}
 
+    using LargeAllocator<T>::construct;  // with arguments: as LargeAllocator
     template <class U>
     void construct(U* p) noexcept(std::is_nothrow_default_constructible_v<U>) {
         if constexpr (!(std::is_trivially_copyable_v<U> && std::is_trivially_destructible_v<U>))
             ::new (static_cast<void*>(p)) U;
     }
-    template <class U, class... Args>
-    void construct(U* p, Args&&... args) {
-        ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
-    }
-    template <class U>
-    bool operator==(const UnwrittenAllocator<U>&) const { return true; }
 };
 
 }  // namespace wedge
