@@ -115,6 +115,7 @@ MaafEffect::MaafEffect(int width, int height, Compute compute)
                 MaafAxis a;
                 m_compute(p, k, a);
                 m_central[p].sx[k] = a.sx[0];
+                m_central[p].weight[k] = a.weight[0];
                 m_central[p].pairs[k] = uint8_t(a.pairs);
             }
         }
@@ -348,14 +349,16 @@ int windowRadius(const MaafAxis& ax, float step, int maxRadius) {
 /// Neighbour test shared by both passes; on acceptance gives the signed offset a (output minus
 /// input, along `axis` of the output pixel's frame) and the in-plane distance r.
 enum class Neighbour { Accepted, OtherSurface, Rejected };
-Neighbour neighbour(const FrameBuffers& fb, const MaafEffect& params, const AxisFrame& f, size_t p, size_t q, int axis,
+inline Neighbour neighbour(const FrameBuffers& fb, const MaafEffect& params, const AxisFrame& f, size_t p, size_t q, int axis,
                     const MaafOptions& o, float& a, float& r) {
     a = r = 0;
     if (q == p) return Neighbour::Accepted;
-    if (!sameSurface(fb, p, q, o.normalCos) || !onTangentPlane(fb, p, q, o.planeDistance)) return Neighbour::OtherSurface;
+    if (!sameSurface(fb, p, q, o.normalCos)) return Neighbour::OtherSurface;
+    // onTangentPlane(), with the offset the filter needs anyway (|dot| is the same either way round).
+    const Vec3f dP = fb.position[p] - fb.position[q];
+    if (!(std::abs(dot(dP, fb.normal[p])) <= o.planeDistance * fb.footprint[p])) return Neighbour::OtherSurface;
     float wp = params.centralSx(p, axis), wq = params.centralSx(q, axis);
     if (wp > o.bandwidthRatio * wq || wq > o.bandwidthRatio * wp) return Neighbour::Rejected;
-    Vec3f dP = fb.position[p] - fb.position[q];
     float a0 = dot(dP, f.axis[0]), a1 = dot(dP, f.axis[1]);
     a = axis == 0 ? a0 : a1;
     r = std::sqrt(a0 * a0 + a1 * a1);
@@ -421,7 +424,7 @@ Image3f MaafAccumulator::filter(const MaafEffect& params, const FrameBuffers& fb
         for (int x = 0; x < W; ++x) {
             size_t p = size_t(y) * W + x;
             if (fb.object[p] < 0) continue;
-            const MaafAxis ax = params.axis(p, 0);
+            const MaafAxis ax = params.filterAxis(p, 0);
             const AxisFrame& f = frames[p];
             float* out = &inter[interOffset[p]];
             const int B = interBands[p];  // the central-only band follows the B bands
@@ -465,7 +468,7 @@ Image3f MaafAccumulator::filter(const MaafEffect& params, const FrameBuffers& fb
                 result[p] = fallback[p];
                 continue;
             }
-            const MaafAxis ax = params.axis(p, 1);
+            const MaafAxis ax = params.filterAxis(p, 1);
             const AxisFrame& f = frames[p];
             float h[4] = {0, 0, 0, 0}, h0[4] = {0, 0, 0, 0};  // values..., weight (C <= 4)
             const Window win(fb, params, ax, f, x, y, 1, o);

@@ -134,8 +134,8 @@ struct MaafOptions {
 /// One effect's components for every pixel, computed on demand: a MaafPixel is 232 bytes, and
 /// storing one per pixel and effect cost a 720x720 render 240 MB of freshly zeroed pages (7% of
 /// its CPU time, `perf record`), more than computing them three times. Kept per pixel: what the
-/// neighbours of a pixel and the accumulator's layout need (the central width and component
-/// count of each axis, 12 bytes).
+/// neighbours of a pixel, the accumulator's layout and the filter of a central-only axis need
+/// (the central width, weight and component count of each axis, 20 bytes).
 class MaafEffect {
 public:
     /// Writes pixel p's components along axis k.
@@ -155,10 +155,20 @@ public:
     /// sx[0] of pixel p along axis k (the central component's spatial bandwidth).
     float centralSx(size_t p, int k) const { return m_central[p].sx[k]; }
     int pairs(size_t p, int k) const { return m_central[p].pairs[k]; }
+    /// What the image-space filter reads of pixel p's axis k: the stored central width and
+    /// weight where the axis uses the central component only (most pixels), else axis(p, k).
+    MaafAxis filterAxis(size_t p, int k) const {
+        if (m_central[p].pairs[k] > 1) return axis(p, k);
+        MaafAxis a{};
+        a.pairs = 1;
+        a.sx[0] = m_central[p].sx[k];
+        a.weight[0] = m_central[p].weight[k];
+        return a;
+    }
 
 private:
     struct Central {
-        float sx[2];
+        float sx[2], weight[2];
         uint8_t pairs[2];
     };
     int m_width, m_height;
