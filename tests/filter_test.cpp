@@ -317,6 +317,35 @@ MaafPixel uniformParams(int pairs, bool lens) {
 
 }  // namespace
 
+TEST(MaafFilter, FilterAxisIsTheFullAxisWhereTheFilterReadsIt) {
+    // The filter reads a central-only axis from the stored central width and weight instead of
+    // recomputing its components: the same pairs, width and weight as axis(), per pixel and axis,
+    // with widths and weights that vary (eq. 10's weights are not 1), and the full axis elsewhere.
+    const int W = 6, H = 5;
+    Image<MaafPixel> stored(W, H);
+    for (int i = 0; i < W * H; ++i) {
+        MaafPixel m = uniformParams(1 + (i % 3), i % 2 == 0);
+        for (int k = 0; k < 2; ++k) {
+            if ((i + k) % 4 == 0) m.axis[k].pairs = 1;
+            m.axis[k].sx[0] *= 1.f + 0.1f * float(i + k);
+            m.axis[k].weight[0] = 0.3f + 0.05f * float(i * 2 + k);
+        }
+        stored[size_t(i)] = m;
+    }
+    MaafEffect effect(stored);
+    int central = 0;
+    for (size_t p = 0; p < stored.size(); ++p)
+        for (int k = 0; k < 2; ++k) {
+            const MaafAxis full = effect.axis(p, k), f = effect.filterAxis(p, k);
+            ASSERT_EQ(f.pairs, full.pairs);
+            EXPECT_EQ(f.sx[0], full.sx[0]) << p << " " << k;
+            EXPECT_EQ(f.weight[0], full.weight[0]) << p << " " << k;
+            if (full.pairs > 1) EXPECT_EQ(0, std::memcmp(&f, &full, sizeof(MaafAxis))) << p << " " << k;
+            central += full.pairs == 1;
+        }
+    EXPECT_GT(central, 10);
+}
+
 TEST(MaafFilter, SeparableAccumulationEqualsDirectEq22) {
     // A tiny image with a handful of samples per pixel: filter through the accumulations
     // (eq. 23) and the two separable passes (eq. 21 per axis), then evaluate eq. 22 directly
