@@ -92,6 +92,61 @@ void BM_AafFilter(benchmark::State& state) {
 }
 BENCHMARK(BM_AafFilter)->Unit(benchmark::kMillisecond);
 
+/// MAAF's image-space filter alone (eq. 21 on both axes, filter/maaf.h) on a 512x512 plane:
+/// central-only pixels with, every 64 columns, a 16-column band of pixels with 3 component
+/// pairs on both axes (about the share of outer-component pixels in the 512x512 scenes), each
+/// pixel's accumulations (rgb and weight) from 4 samples.
+void BM_MaafFilter(benchmark::State& state) {
+    const int W = 512, H = 512, pairs = 3;
+    FrameBuffers fb(W, H);
+    Image<filter::AxisFrame> frames(W, H);
+    Image<filter::MaafPixel> stored(W, H);
+    filter::WedgeShape wedge;
+    wedge.omegaYMax = 0.8;
+    wedge.sMin = 0.6;
+    wedge.sMax = 1.5;
+    const std::vector<filter::MaafComponent> central = filter::maafComponents(1, wedge),
+                                             outer = filter::maafComponents(pairs, wedge);
+    for (int y = 0; y < H; ++y)
+        for (int x = 0; x < W; ++x) {
+            size_t i = size_t(y) * W + x;
+            fb.object[i] = 0;
+            fb.normal[i] = {0, 0, 1};
+            fb.position[i] = {float(x), float(y), 0};
+            fb.footprint[i] = 1;
+            fb.coverage[i] = 1;
+            frames[i] = {{{1, 0, 0}, {0, 1, 0}}, {1, 1}};
+            const auto& comps = x % 64 < 16 ? outer : central;
+            filter::MaafPixel m{};
+            for (int k = 0; k < 2; ++k) {
+                m.axis[k].pairs = int(comps.size());
+                for (const auto& c : comps) {
+                    m.axis[k].cx[c.p] = float(c.cx);
+                    m.axis[k].sx[c.p] = std::max(float(c.sx) * 2.449490f, 0.1f);  // as buildAxis
+                    m.axis[k].weight[c.p] = float((c.p ? 2 : 1) * c.mu);
+                    m.axis[k].cy[c.p] = float(c.cy);
+                }
+            }
+            stored[i] = m;
+        }
+    filter::MaafEffect effect(stored);
+    filter::MaafAccumulator acc(effect, pairs, 3);
+    for (size_t i = 0; i < stored.size(); ++i) {
+        for (uint32_t s = 0; s < 4; ++s) {
+            auto rnd = [&](uint32_t j) { return float(hash32(uint32_t(i) * 16 + s * 4 + j) & 0xffff) / 65535.f; };
+            const float value[3] = {rnd(0), rnd(1), rnd(2)}, yy[2] = {2 * rnd(3) - 1, 2 * rnd(0) - 1}, u[2] = {0, 0};
+            acc.add(i, value, 1.f, yy, u, stored[i]);
+        }
+        acc.scale(i, 0.25f);
+    }
+    filter::MaafOptions o;
+    o.pairs = pairs;
+    const Image3f fallback(W, H);
+    for (auto _ : state) benchmark::DoNotOptimize(acc.filter(effect, fb, frames, fallback, o));
+    state.SetItemsProcessed(state.iterations() * W * H);
+}
+BENCHMARK(BM_MaafFilter)->Unit(benchmark::kMillisecond);
+
 }  // namespace
 
 BENCHMARK_MAIN();
