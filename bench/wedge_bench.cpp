@@ -69,21 +69,31 @@ BENCHMARK_CAPTURE(BM_Method, aaf, "aaf")->Unit(benchmark::kMillisecond)->Iterati
 BENCHMARK_CAPTURE(BM_Method, maaf, "maaf")->Unit(benchmark::kMillisecond)->Iterations(3);
 BENCHMARK_CAPTURE(BM_Method, atrous, "atrous")->Unit(benchmark::kMillisecond)->Iterations(3);
 
+/// Frame buffers and filter frames of a W x H plane seen head-on, one world unit per pixel.
+void planeBuffers(FrameBuffers& fb, Image<filter::AxisFrame>& frames) {
+    for (int y = 0; y < fb.height; ++y)
+        for (int x = 0; x < fb.width; ++x) {
+            size_t i = size_t(y) * fb.width + x;
+            fb.object[i] = 0;
+            fb.normal[i] = {0, 0, 1};
+            fb.position[i] = {float(x), float(y), 0};
+            fb.footprint[i] = 1;
+            fb.coverage[i] = 1;
+            frames[i] = {{{1, 0, 0}, {0, 1, 0}}, {1, 1}};
+        }
+}
+
 /// The AAF separable filter alone on a 512x512 plane with spatially varying widths.
 void BM_AafFilter(benchmark::State& state) {
     const int W = 512, H = 512;
     FrameBuffers fb(W, H);
     Image<filter::AxisFrame> frames(W, H);
+    planeBuffers(fb, frames);
     Image3f signal(W, H);
     Image1f omega(W, H);
     for (int y = 0; y < H; ++y)
         for (int x = 0; x < W; ++x) {
             size_t i = size_t(y) * W + x;
-            fb.object[i] = 0;
-            fb.normal[i] = {0, 0, 1};
-            fb.position[i] = {float(x), float(y), 0};
-            fb.footprint[i] = 1;
-            frames[i] = {{{1, 0, 0}, {0, 1, 0}}, {1, 1}};
             signal[i] = Vec3f(float(hash32(uint32_t(i)) & 255) / 255.f);
             omega[i] = 0.1f + 0.3f * float((x / 64 + y / 64) % 3);
         }
@@ -100,6 +110,7 @@ void BM_MaafFilter(benchmark::State& state) {
     const int W = 512, H = 512, pairs = 3;
     FrameBuffers fb(W, H);
     Image<filter::AxisFrame> frames(W, H);
+    planeBuffers(fb, frames);
     Image<filter::MaafPixel> stored(W, H);
     filter::WedgeShape wedge;
     wedge.omegaYMax = 0.8;
@@ -110,12 +121,6 @@ void BM_MaafFilter(benchmark::State& state) {
     for (int y = 0; y < H; ++y)
         for (int x = 0; x < W; ++x) {
             size_t i = size_t(y) * W + x;
-            fb.object[i] = 0;
-            fb.normal[i] = {0, 0, 1};
-            fb.position[i] = {float(x), float(y), 0};
-            fb.footprint[i] = 1;
-            fb.coverage[i] = 1;
-            frames[i] = {{{1, 0, 0}, {0, 1, 0}}, {1, 1}};
             const auto& comps = x % 64 < 16 ? outer : central;
             filter::MaafPixel m{};
             for (int k = 0; k < 2; ++k) {
