@@ -340,7 +340,9 @@ TEST(MaafFilter, FilterAxisIsTheFullAxisWhereTheFilterReadsIt) {
             ASSERT_EQ(f.pairs, full.pairs);
             EXPECT_EQ(f.sx[0], full.sx[0]) << p << " " << k;
             EXPECT_EQ(f.weight[0], full.weight[0]) << p << " " << k;
-            if (full.pairs > 1) EXPECT_EQ(0, std::memcmp(&f, &full, sizeof(MaafAxis))) << p << " " << k;
+            if (full.pairs > 1) {
+                EXPECT_EQ(0, std::memcmp(&f, &full, sizeof(MaafAxis))) << p << " " << k;
+            }
             central += full.pairs == 1;
         }
     EXPECT_GT(central, 10);
