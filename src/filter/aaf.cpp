@@ -93,13 +93,13 @@ void pass(const Image3f& src, const Image1f& srcWeight, Image3f& dst, Image1f& d
                     w[k + radius] = srcWeight[q];
                     continue;
                 }
-                if (!sameSurface(fb, p, q, o.normalCos) || !onTangentPlane(fb, p, q, o.planeDistance)) {
+                const Vec3f dP = fb.position[q] - P;
+                if (!sameSurface(fb, p, q, o.normalCos) || !onTangentPlane(fb, p, dP, o.planeDistance)) {
                     cut[k + radius] = true;
                     continue;
                 }
                 float oq = std::max(omega[q], 1.f / (o.maxRadius * frames[q].step[axis]));
                 if (oq > o.bandwidthRatio * omEff || omEff > o.bandwidthRatio * oq) continue;
-                Vec3f dP = fb.position[q] - P;
                 float a0 = dot(dP, f.axis[0]), a1 = dot(dP, f.axis[1]);
                 float r2o2 = (a0 * a0 + a1 * a1) * omEff * omEff;
                 if (r2o2 > 1.f) continue;  // cut at r Omega > 1 (NOTES)

@@ -353,10 +353,8 @@ inline Neighbour neighbour(const FrameBuffers& fb, const MaafEffect& params, con
                     const MaafOptions& o, float& a, float& r) {
     a = r = 0;
     if (q == p) return Neighbour::Accepted;
-    if (!sameSurface(fb, p, q, o.normalCos)) return Neighbour::OtherSurface;
-    // onTangentPlane(), with the offset the filter needs anyway (|dot| is the same either way round).
     const Vec3f dP = fb.position[p] - fb.position[q];
-    if (!(std::abs(dot(dP, fb.normal[p])) <= o.planeDistance * fb.footprint[p])) return Neighbour::OtherSurface;
+    if (!sameSurface(fb, p, q, o.normalCos) || !onTangentPlane(fb, p, dP, o.planeDistance)) return Neighbour::OtherSurface;
     float wp = params.centralSx(p, axis), wq = params.centralSx(q, axis);
     if (wp > o.bandwidthRatio * wq || wq > o.bandwidthRatio * wp) return Neighbour::Rejected;
     float a0 = dot(dP, f.axis[0]), a1 = dot(dP, f.axis[1]);

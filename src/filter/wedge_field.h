@@ -45,10 +45,15 @@ inline bool sameSurface(const FrameBuffers& fb, size_t p, size_t q, float normal
     return dot(fb.normal[p], fb.normal[q]) >= normalCos;
 }
 
-/// True when q's hit lies within `planeDistance` pixel footprints of p's tangent plane (a box
-/// face in front of a parallel wall of the same object is off it).
+/// True when a hit at `offset` from p's (either way round: q - p or p - q) lies within
+/// `planeDistance` pixel footprints of p's tangent plane (a box face in front of a parallel wall
+/// of the same object is off it). For filters that need the offset anyway.
+inline bool onTangentPlane(const FrameBuffers& fb, size_t p, const Vec3f& offset, float planeDistance) {
+    return std::abs(dot(offset, fb.normal[p])) <= planeDistance * fb.footprint[p];
+}
+/// The same for pixel q's hit.
 inline bool onTangentPlane(const FrameBuffers& fb, size_t p, size_t q, float planeDistance) {
-    return std::abs(dot(fb.position[q] - fb.position[p], fb.normal[p])) <= planeDistance * fb.footprint[p];
+    return onTangentPlane(fb, p, fb.position[q] - fb.position[p], planeDistance);
 }
 
 }  // namespace wedge::filter
