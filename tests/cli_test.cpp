@@ -132,6 +132,22 @@ TEST(Cli, SyntaxErrorNamesLine) {
     expectRejected(scene(kSphere, "\"render\": {", "\"render\": {,"), "bad.json:6:");
 }
 
+TEST(Cli, DuplicateKeyNamesItsPath) {
+    // nlohmann keeps the last of two equal keys; wedge refuses the scene instead of rendering
+    // with one of them silently. The same key in two different objects is fine.
+    expectRejected(scene(kSphere, "\"fov_y\": 40", "\"fov_y\": 40, \"fov_y\": 50"), "bad.json: camera.fov_y: duplicate key 'fov_y'");
+    expectRejected(scene(kSphere + ", " + kSphere, "\"radius\": 0.5, \"material\": \"white\"}]",
+                         "\"radius\": 0.5, \"radius\": 1, \"material\": \"white\"}]"),
+                   "bad.json: objects[1].radius: duplicate key 'radius'");
+}
+
+TEST(Cli, NumberOutOfRangeNamesItsPath) {
+    expectRejected(scene(R"({"type": "sphere", "center": [0, 0, 0], "radius": 1e400, "material": "white"})"),
+                   "bad.json: objects[0].radius: invalid JSON: number overflow");
+    expectRejected(scene(kSphere, "\"edge2\": [0, 0, 1]", "\"edge2\": [0, 0, -1e999]"),
+                   "bad.json: lights[0].edge2[2]: invalid JSON: number overflow");
+}
+
 TEST(Cli, MissingSceneFile) {
     std::string err;
     EXPECT_EQ(runWedge("render /nonexistent/room.json --quiet", nullptr, &err), 2);
@@ -198,6 +214,32 @@ TEST(Cli, MtlTermsThatAreNotRenderedAreNamed) {
     EXPECT_EQ(err.find("warning"), std::string::npos) << err;
 }
 
+TEST(Cli, MtlColoursObeyTheSceneFileRules) {
+    // An MTL's Kd and Ke are checked as the scene file's "albedo" and "emission" are: they were
+    // clamped silently before (a negative albedo to 0, an albedo of 1.2 to 1). Emission above 1
+    // is a light's radiance (the Cornell box's Ke 17 12 4) and renders.
+    std::string dir = tempDir();
+    writeFile(dir + "/quad.obj", "mtllib quad.mtl\nv -1 0 -1\nv 1 0 -1\nv 1 0 1\nv -1 0 1\nusemtl a\nf 1 4 3\nf 1 3 2\n");
+    const std::string json = scene(R"({"type": "mesh", "file": "quad.obj"})");
+    auto run = [&](const std::string& mtl, std::string& err) {
+        writeFile(dir + "/quad.mtl", "newmtl a\n" + mtl);
+        writeFile(dir + "/s.json", json);
+        fs::remove(dir + "/x.png");
+        return runWedge("render " + dir + "/s.json --quiet -o " + dir + "/x.png", nullptr, &err);
+    };
+    std::string err;
+    for (const char* mtl : {"Kd -0.1 0.5 0.5\n", "Kd 1.2 0.5 0.5\n", "Kd 1e999 0.5 0.5\n"}) {
+        EXPECT_EQ(run(mtl, err), 2) << mtl;
+        EXPECT_NE(err.find("s.json: objects[0].file: '" + dir + "/quad.obj': material 'a' (its MTL): Kd components must lie in [0, 1]"),
+                  std::string::npos) << err;
+        EXPECT_FALSE(fs::exists(dir + "/x.png"));
+    }
+    EXPECT_EQ(run("Kd 0.5 0.5 0.5\nKe -5 0 0\n", err), 2);
+    EXPECT_NE(err.find("material 'a' (its MTL): Ke components must be finite and non-negative, got -5 0 0"), std::string::npos) << err;
+    EXPECT_EQ(run("Kd 0.5 0.5 0.5\nKe 17 12 4\n", err), 0) << err;
+    EXPECT_TRUE(fs::exists(dir + "/x.png"));
+}
+
 TEST(Cli, BadFlags) {
     std::string dir = tempDir();
     writeFile(dir + "/good.json", scene(kSphere));
@@ -219,6 +261,35 @@ TEST(Cli, BadFlags) {
     EXPECT_EQ(runWedge("render " + g + "-o /nonexistent-dir/x.png", nullptr, &err), 2) << err;
     EXPECT_EQ(runWedge("render", nullptr, &err), 2) << err;
     EXPECT_EQ(runWedge("frobnicate", nullptr, &err), 2) << err;
+}
+
+TEST(Cli, NumericFlagsRejectNanAndSayTheirRange) {
+    // CLI11's range checks pass NaN (every comparison with it is false): before, --sigma-color nan
+    // rendered and failed in the filter, without naming the flag, and an "x" resolution side of
+    // 11 digits went through sscanf's int overflow.
+    std::string dir = tempDir();
+    writeFile(dir + "/good.json", scene(kSphere));
+    const std::string g = dir + "/good.json --quiet -o " + dir + "/x.png ";
+    struct Case { std::string args, expect; };
+    for (const Case& c : std::vector<Case>{
+             {"render " + g + "--method atrous --sigma-color nan", "--sigma-color: expected a number in [1e-06, 1000000], got 'nan'"},
+             {"render " + g + "--method atrous --sigma-normal inf", "--sigma-normal: expected a number in [1e-06, 1000000], got 'inf'"},
+             {"render " + g + "--resolution 99999999999x2", "--resolution 99999999999x2: expected WxH with integers from 1 to 16384"},
+             {"render " + g + "--resolution -3x2", "expected WxH with integers from 1 to 16384"},
+             {"experiment " + dir + "/good.json --methods mc --spp 4 --reference-spp 0 --out " + dir + "/e",
+              "--reference-spp: expected a number in [1, 1048576], got '0'"},
+             {"experiment " + dir + "/good.json --methods mc --spp 4 --reference-spp 8 --threads -1 --out " + dir + "/e",
+              "--threads: expected a number in [0, 1024], got '-1'"},
+             {"raster " + g + "--shading ds --cache-entries 4 --stats " + dir + "/s.json --lens-cutoff nan",
+              "--lens-cutoff: expected a positive number, got 'nan'"}}) {
+        std::string err;
+        EXPECT_EQ(runWedge(c.args, nullptr, &err), 2) << c.args << "\n" << err;
+        EXPECT_NE(err.find(c.expect), std::string::npos) << c.args << "\n" << err;
+        EXPECT_FALSE(fs::exists(dir + "/x.png"));
+        EXPECT_FALSE(fs::exists(dir + "/e"));
+    }
+    std::string err;
+    EXPECT_EQ(runWedge("render " + g + "--method atrous --sigma-color 0.5 --resolution 6X4", nullptr, &err), 0) << err;
 }
 
 TEST(Cli, ScenesListsBuiltins) {

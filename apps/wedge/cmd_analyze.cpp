@@ -18,6 +18,7 @@
 #include "io/plot.h"
 #include "analysis/tables.h"
 #include "apps/wedge/commands.h"
+#include "apps/wedge/common.h"
 #include "core/error.h"
 #include "filter/maaf_components.h"
 #include "io/image_io.h"
@@ -335,7 +336,7 @@ void registerAnalyze(CLI::App& app) {
     co->add_option("--fsf-sigma", ca->fsfSigma, "Gaussian FSF std: printed (eq. 4, default) or half (the parallelogram's half-width)")
         ->check(CLI::IsMember({"printed", "half"}));
     co->add_option("--sigma-scale", ca->sigmaScale, "Gaussians: std = this x the box half-width (default 1)")
-        ->check(CLI::Range(1e-3, 1e3));
+        ->check(numberIn(1e-3, 1e3));
     co->add_option("--grid", ca->grid, "Also evaluate on an N x N midpoint grid (cross-check)")->check(CLI::Range(2, 8192));
     co->callback([ca] { runCoverage(*ca); });
 

@@ -75,10 +75,10 @@ void registerExperiment(CLI::App& app) {
     cmd->add_option("--methods", args->options.methods, "Comma-separated methods (default: all; unavailable ones are skipped)")
         ->delimiter(',');
     cmd->add_option("--spp", args->options.spp, "Base samples per pixel of every method (initial spp for aaf/maaf)")
-        ->check(CLI::PositiveNumber)
+        ->check(numberIn(1, 1 << 20))
         ->capture_default_str();
     cmd->add_option("--reference-spp", args->options.referenceSpp, "Samples per pixel of the MC reference")
-        ->check(CLI::PositiveNumber)
+        ->check(numberIn(1, 1 << 20))
         ->capture_default_str();
     cmd->add_option("--out", args->options.outDir, "Output directory (created if missing)")->required();
     cmd->add_option("--cache", args->options.cacheDir, "Directory of cached references (default: OUT/cache)");
@@ -87,18 +87,18 @@ void registerExperiment(CLI::App& app) {
     cmd->add_option("--anchor", args->options.anchor,
                     "Method the others are matched to (default: maaf, else aaf, else atrous, else the first)");
     cmd->add_option("--max-spp", args->options.maxSpp, "Upper bound of the searches (default: reference spp / 4)")
-        ->check(CLI::NonNegativeNumber);
+        ->check(nonNegativeNumber());
     cmd->add_option("--tolerance", args->options.tolerance, "Relative spp resolution of the searches")
-        ->check(CLI::Range(0.0, 10.0));
+        ->check(numberIn(0.0, 10.0));
     cmd->add_option("--repeat", args->options.repeat, "Renders per probe (and re-timings per row); the fastest counts")
         ->check(CLI::Range(1, 20));
     cmd->add_option("--resolution", args->resolution, "Override the camera resolution, WxH");
     cmd->add_option("--seed", args->seed, "Random seed of the methods (default: the scene's render.seed)")
-        ->check(CLI::NonNegativeNumber);
-    cmd->add_option("--threads", args->threads, "Worker threads (0: all cores)")->check(CLI::NonNegativeNumber);
+        ->check(numberIn(0, 4294967295.0));
+    cmd->add_option("--threads", args->threads, "Worker threads (0: all cores)")->check(numberIn(0, 1024));
     render::RenderOptions& r = args->options.base;
     cmd->add_option("--max-extra-spp", r.maxExtraSpp, "aaf/maaf: cap on adaptive samples per pixel (default 16; the papers use 100)")
-        ->check(CLI::NonNegativeNumber);
+        ->check(numberIn(0, 65536));
     cmd->add_option("--maaf-components", r.maafComponents, "maaf: filters per 2D/3D subspace (3, 5 or 7)")
         ->check(CLI::IsMember({3, 5, 7}));
     cmd->add_flag("!--no-focal-fallback", r.maafFocalFallback,
@@ -111,10 +111,10 @@ void registerExperiment(CLI::App& app) {
     cmd->add_option("--maaf-weights", r.maafWeights, "maaf: component weights mu_p (sampling, eq10 or unit)")
         ->check(CLI::IsMember({"sampling", "eq10", "unit"}));
     cmd->add_option("--atrous-iterations", r.atrousIterations, "atrous: wavelet levels")->check(CLI::Range(1, 10));
-    cmd->add_option("--sigma-color", r.atrousSigmaColor, "atrous: colour edge-stopping sigma")->check(CLI::PositiveNumber);
-    cmd->add_option("--sigma-normal", r.atrousSigmaNormal, "atrous: normal edge-stopping sigma")->check(CLI::PositiveNumber);
+    cmd->add_option("--sigma-color", r.atrousSigmaColor, "atrous: colour edge-stopping sigma")->check(numberIn(1e-6, 1e6));
+    cmd->add_option("--sigma-normal", r.atrousSigmaNormal, "atrous: normal edge-stopping sigma")->check(numberIn(1e-6, 1e6));
     cmd->add_option("--sigma-position", r.atrousSigmaPosition, "atrous: position edge-stopping sigma (pixel footprints)")
-        ->check(CLI::PositiveNumber);
+        ->check(numberIn(1e-6, 1e6));
     cmd->add_flag("!--no-variance", r.atrousVarianceGuided, "atrous: plain colour edge-stopping instead of variance-guided");
     cmd->add_flag("-q,--quiet", args->options.quiet, "No progress on stderr and no table on stdout");
     cmd->callback([args] {

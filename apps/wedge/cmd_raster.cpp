@@ -149,22 +149,22 @@ void registerRaster(CLI::App& app) {
         ->check(CLI::Range(size_t(1), size_t(1) << 30))
         ->capture_default_str();
     cmd->add_option("--spp", args->spp, "Visibility samples per pixel")->check(CLI::Range(1, 1024))->capture_default_str();
-    cmd->add_option("--seed", args->seed, "Random seed (default: the scene's render.seed)")->check(CLI::NonNegativeNumber);
-    cmd->add_option("--threads", args->threads, "Worker threads (0: all cores)")->check(CLI::NonNegativeNumber);
+    cmd->add_option("--seed", args->seed, "Random seed (default: the scene's render.seed)")->check(numberIn(0, 4294967295.0));
+    cmd->add_option("--threads", args->threads, "Worker threads (0: all cores)")->check(numberIn(0, 1024));
     cmd->add_option("--resolution", args->resolution, "Override the camera resolution, WxH");
     cmd->add_option("-o,--output", args->outputs, "Output image (.png, .exr, .pfm); repeatable");
     cmd->add_option("--reference-out", args->referenceOutput, "Also write the reference (every sample shaded)");
     cmd->add_option("--stats", args->stats, "Write counts, timings and the image error as JSON");
     cmd->add_flag("--no-reference", args->noReference, "Skip the reference render (no rel_mse in the stats)");
     cmd->add_option("--lens-cutoff", args->lensCutoff, "AAS: Omega_A^max of the disc aperture (cycles per lens radius)")
-        ->check(CLI::PositiveNumber)
+        ->check(positiveNumber())
         ->capture_default_str();
     cmd->add_option("--shutter-cutoff", args->shutterCutoff, "AAS: Omega_S^max of the box shutter (cycles per shutter)")
-        ->check(CLI::PositiveNumber)
+        ->check(positiveNumber())
         ->capture_default_str();
     cmd->add_option("--split-edge", args->splitEdge,
                     "Split blurred triangles longer than this on the canonical image (pixels; 0: never)")
-        ->check(CLI::NonNegativeNumber)
+        ->check(nonNegativeNumber())
         ->capture_default_str();
     cmd->add_flag("--no-grid-align", args->noGridAlign,
                   "AAS: keep every lattice anchored at the screen origin instead of at its triangle's corner");

@@ -89,12 +89,12 @@ void registerRender(CLI::App& app) {
     cmd->add_option("--atrous-iterations", args->options.atrousIterations, "atrous: wavelet levels")
         ->check(CLI::Range(1, 10));
     cmd->add_option("--sigma-color", args->options.atrousSigmaColor, "atrous: colour edge-stopping sigma")
-        ->check(CLI::Range(1e-6, 1e6));
+        ->check(numberIn(1e-6, 1e6));
     cmd->add_option("--sigma-normal", args->options.atrousSigmaNormal, "atrous: normal edge-stopping sigma")
-        ->check(CLI::Range(1e-6, 1e6));
+        ->check(numberIn(1e-6, 1e6));
     cmd->add_option("--sigma-position", args->options.atrousSigmaPosition,
                     "atrous: position edge-stopping sigma (in pixel footprints)")
-        ->check(CLI::Range(1e-6, 1e6));
+        ->check(numberIn(1e-6, 1e6));
     cmd->add_flag("!--no-variance", args->options.atrousVarianceGuided,
                   "atrous: plain colour edge-stopping instead of variance-guided (SVGF-style)");
     cmd->add_flag("-q,--quiet", args->options.quiet, "No progress bar and no summary");

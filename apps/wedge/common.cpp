@@ -1,6 +1,11 @@
 #include "apps/wedge/common.h"
 
+#include <cerrno>
+#include <cmath>
 #include <cstdio>
+#include <cstdlib>
+#include <functional>
+#include <optional>
 #include <filesystem>
 #include <fstream>
 #include <unistd.h>
@@ -15,13 +20,54 @@ void printWarnings(const scene::SceneDesc& desc) {
 
 void applyResolution(scene::SceneDesc& desc, const std::string& resolution) {
     if (resolution.empty()) return;
-    int w = 0, h = 0;
-    char x = 0, extra = 0;
-    if (std::sscanf(resolution.c_str(), "%d%c%d%c", &w, &x, &h, &extra) != 3 || (x != 'x' && x != 'X') || w <= 0 ||
-        h <= 0 || w > 16384 || h > 16384)
-        throw Error("--resolution " + resolution, "expected WxH with positive integers, e.g. 256x256");
+    constexpr int kMax = 16384;
+    // Digits only (sscanf's %d would take "-3" and overflow on "99999999999"), then the bound.
+    auto side = [](const std::string& digits) {
+        if (digits.empty() || digits.size() > 6 || digits.find_first_not_of("0123456789") != std::string::npos) return -1;
+        return std::stoi(digits);
+    };
+    size_t x = resolution.find_first_of("xX");
+    int w = x == std::string::npos ? -1 : side(resolution.substr(0, x));
+    int h = x == std::string::npos ? -1 : side(resolution.substr(x + 1));
+    if (w <= 0 || h <= 0 || w > kMax || h > kMax)
+        throw Error("--resolution " + resolution,
+                    "expected WxH with integers from 1 to " + std::to_string(kMax) + ", e.g. 256x256");
     desc.camera.width = w;
     desc.camera.height = h;
+}
+
+namespace {
+/// A flag's value as a finite number, or nothing.
+std::optional<double> finiteNumber(const std::string& text) {
+    const char* begin = text.c_str();
+    char* end = nullptr;
+    errno = 0;
+    double v = std::strtod(begin, &end);
+    if (end == begin || *end != 0 || errno == ERANGE || !std::isfinite(v)) return std::nullopt;
+    return v;
+}
+
+CLI::Validator numberCheck(std::string what, std::function<bool(double)> ok) {
+    return CLI::Validator(
+        [what, ok](std::string& text) -> std::string {
+            std::optional<double> v = finiteNumber(text);
+            return v && ok(*v) ? std::string() : "expected " + what + ", got '" + text + "'";
+        },
+        "NUMBER");
+}
+
+std::string shortNumber(double v) {
+    char s[32];
+    std::snprintf(s, sizeof s, "%.10g", v);
+    return s;
+}
+}  // namespace
+
+CLI::Validator positiveNumber() { return numberCheck("a positive number", [](double v) { return v > 0; }); }
+CLI::Validator nonNegativeNumber() { return numberCheck("a number >= 0", [](double v) { return v >= 0; }); }
+CLI::Validator numberIn(double lo, double hi) {
+    return numberCheck("a number in [" + shortNumber(lo) + ", " + shortNumber(hi) + "]",
+                       [lo, hi](double v) { return v >= lo && v <= hi; });
 }
 
 void writeJsonFile(const std::string& path, const nlohmann::json& j) {

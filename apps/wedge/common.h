@@ -1,6 +1,7 @@
 // Helpers shared by the subcommands.
 #pragma once
 
+#include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 #include <string>
 
@@ -12,6 +13,13 @@ namespace wedge::app {
 void applyResolution(scene::SceneDesc& desc, const std::string& resolution);
 /// Prints the scene's warnings (what it asks for that wedge does not render) to stderr.
 void printWarnings(const scene::SceneDesc& desc);
+/// Numeric flag checks. CLI11's own (PositiveNumber, Range) let NaN through, since every
+/// comparison with it is false, and PositiveNumber reports its range as 2.2e-308 to 1.8e308;
+/// these accept finite numbers only and say what they expect: "expected a positive number,
+/// got 'nan'".
+CLI::Validator positiveNumber();
+CLI::Validator nonNegativeNumber();
+CLI::Validator numberIn(double lo, double hi);
 /// Writes JSON through a temporary file and a rename.
 void writeJsonFile(const std::string& path, const nlohmann::json& j);
 

@@ -31,9 +31,57 @@ nlohmann::json JsonNode::parseFile(const std::string& file) {
     if (!in) throw Error(file, "cannot open for reading");
     std::stringstream ss;
     ss << in.rdbuf();
-    std::string text = ss.str();
+    return parseText(ss.str(), file);
+}
+
+nlohmann::json JsonNode::parseText(const std::string& text, const std::string& file) {
+    // RFC 8259 leaves duplicate keys to the parser; nlohmann keeps the last one silently, so a
+    // scene with two "fov_y" would render with one of them and no word. The callback sees
+    // every key as it is read and keeps the keys of each open object, with the path to it.
+    struct Open {
+        bool object = false;
+        size_t index = 0;  // arrays: the next element's index
+        std::string key;   // objects: the key being read
+        std::set<std::string> keys;
+    };
+    std::vector<Open> open;
+    auto path = [&] {
+        std::string p;
+        for (const Open& o : open) {
+            if (o.object) p += (p.empty() ? "" : ".") + o.key;
+            else p += "[" + std::to_string(o.index) + "]";
+        }
+        return p;
+    };
+    auto element = [&] {  // a value (or a nested container) ended: the parent array moves on
+        if (!open.empty() && !open.back().object) ++open.back().index;
+    };
+    using Event = nlohmann::json::parse_event_t;
+    nlohmann::json::parser_callback_t callback = [&](int, Event event, nlohmann::json& parsed) {
+        switch (event) {
+        case Event::object_start:
+        case Event::array_start:
+            open.emplace_back();
+            open.back().object = event == Event::object_start;
+            break;
+        case Event::object_end:
+        case Event::array_end:
+            open.pop_back();
+            element();
+            break;
+        case Event::key: {
+            Open& o = open.back();
+            const std::string& key = parsed.get_ref<const std::string&>();
+            o.key = key;
+            if (!o.keys.insert(key).second) throw Error(file + ": " + path(), "duplicate key '" + key + "'");
+            break;
+        }
+        case Event::value: element(); break;
+        }
+        return true;
+    };
     try {
-        return nlohmann::json::parse(text);
+        return nlohmann::json::parse(text, callback);
     } catch (const nlohmann::json::parse_error& e) {
         // Translate the byte offset into line:column.
         size_t offset = std::min(e.byte > 0 ? e.byte - 1 : 0, text.size());
@@ -44,6 +92,13 @@ nlohmann::json JsonNode::parseFile(const std::string& file) {
         std::string what = e.what();
         auto pos = what.find("syntax error");
         throw Error(file + ":" + std::to_string(line) + ":" + std::to_string(col),
+                    "invalid JSON: " + (pos != std::string::npos ? what.substr(pos) : what));
+    } catch (const nlohmann::json::out_of_range& e) {
+        // A number beyond double's range (1e400): the parser stops there without a position,
+        // but the path of the value it was reading is known.
+        std::string what = e.what(), where = path();
+        auto pos = what.find("number overflow");
+        throw Error(where.empty() ? file : file + ": " + where,
                     "invalid JSON: " + (pos != std::string::npos ? what.substr(pos) : what));
     }
 }

@@ -19,6 +19,9 @@ public:
 
     /// Parses a file; throws wedge::Error naming the file and the line on a syntax error.
     static nlohmann::json parseFile(const std::string& file);
+    /// Parses `text`, read from `file`: a syntax error names the line, a number out of double's
+    /// range and a key repeated within one object name the JSON path.
+    static nlohmann::json parseText(const std::string& text, const std::string& file);
 
     const std::string& path() const { return m_path; }
     std::string where() const;  // "file: path"

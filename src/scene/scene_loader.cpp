@@ -3,6 +3,7 @@
 #include <tiny_obj_loader.h>
 
 #include <algorithm>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -299,8 +300,21 @@ void loadObj(const std::string& path, const std::string& where, int overrideMate
             Material mat;
             mat.name = prefix + m.name;
             mat.albedo = Vec3f(m.diffuse[0], m.diffuse[1], m.diffuse[2]);
-            mat.albedo = vmin(vmax(mat.albedo, Vec3f(0.f)), Vec3f(1.f));
-            mat.emission = vmax(Vec3f(m.emission[0], m.emission[1], m.emission[2]), Vec3f(0.f));
+            mat.emission = Vec3f(m.emission[0], m.emission[1], m.emission[2]);
+            // The MTL's colours obey the scene file's rules for "albedo" and "emission": a
+            // negative or non-finite albedo would make negative or NaN light, and an albedo
+            // above 1 creates energy (the scene file refuses both).
+            auto bad = [&](const char* key, const Vec3f& c, const char* rule) {
+                char v[96];
+                std::snprintf(v, sizeof v, "%g %g %g", c.x, c.y, c.z);
+                throw Error(where, "'" + path + "': material '" + m.name + "' (its MTL): " + key + " " + rule +
+                                       ", got " + v);
+            };
+            if (!isFinite(mat.albedo) || std::min({mat.albedo.x, mat.albedo.y, mat.albedo.z}) < 0 ||
+                maxComponent(mat.albedo) > 1.f)
+                bad("Kd", mat.albedo, "components must lie in [0, 1]");
+            if (!isFinite(mat.emission) || std::min({mat.emission.x, mat.emission.y, mat.emission.z}) < 0)
+                bad("Ke", mat.emission, "components must be finite and non-negative");
             mtlToScene.push_back(uint32_t(materials.size()));
             materials.push_back(mat);
         }
@@ -388,13 +402,7 @@ void loadObj(const std::string& path, const std::string& where, int overrideMate
 }
 
 SceneDesc parseScene(const std::string& jsonText, const std::string& file, const std::string& baseDir) {
-    nlohmann::json doc;
-    try {
-        doc = nlohmann::json::parse(jsonText);
-    } catch (const nlohmann::json::parse_error& e) {
-        throw Error(file, std::string("invalid JSON: ") + e.what());
-    }
-    return SceneParser(file, baseDir).parse(doc);
+    return SceneParser(file, baseDir).parse(io::JsonNode::parseText(jsonText, file));
 }
 
 std::string scenesDirectory() {
