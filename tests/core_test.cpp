@@ -1,6 +1,7 @@
 // Core and I/O: the per-pixel sample generator's stratification and determinism, and image
 // files written and read back (EXR with named channels, PFM orientation, PNG sRGB).
 #include <gtest/gtest.h>
+#include <zlib.h>
 
 #include <filesystem>
 
@@ -172,4 +173,47 @@ TEST(ImageIo, BadFilesAreErrors) {
     EXPECT_THROW(io::readColor(dir + "/x.bmp"), Error);
     EXPECT_THROW(io::checkOutputPath(dir + "/y.jpg", {".png"}), Error);
     EXPECT_FALSE(std::filesystem::exists(dir + "/y.jpg"));
+}
+
+/// The message of the Error that reading `path` throws ("" if none).
+std::string readError(const std::string& path) {
+    try {
+        io::readColor(path);
+    } catch (const Error& e) {
+        return e.what();
+    }
+    return "";
+}
+
+TEST(ImageIo, HeadersAreCheckedBeforeAllocating) {
+    // A damaged header must not make a reader allocate what it asks for: "99999 99999" in a PFM
+    // was 120 GB and ended in "out of memory" (exit code 1), not an error naming the file.
+    std::string dir = test::tempDir();
+    Image3f img(4, 2, Vec3f(0.5f));
+    io::writeColor(dir + "/a.pfm", img);
+    std::string pfm = test::readFile(dir + "/a.pfm");
+    test::writeFile(dir + "/huge.pfm", "PF\n99999 99999\n-1.0\n" + pfm.substr(pfm.size() - 4 * 2 * 3 * 4));
+    EXPECT_NE(readError(dir + "/huge.pfm").find("truncated PFM data (the header gives 99999x99999)"), std::string::npos)
+        << readError(dir + "/huge.pfm");
+    test::writeFile(dir + "/short.pfm", pfm.substr(0, pfm.size() - 4));
+    EXPECT_NE(readError(dir + "/short.pfm").find("truncated PFM data"), std::string::npos);
+    EXPECT_EQ(readError(dir + "/a.pfm"), "");
+
+    // A PNG whose IHDR (with a valid CRC) claims 900000 x 900000 pixels.
+    io::writeColor(dir + "/a.png", img);
+    std::string png = test::readFile(dir + "/a.png");
+    const size_t ihdr = png.find("IHDR");
+    ASSERT_NE(ihdr, std::string::npos);
+    auto put32 = [&](size_t at, uint32_t v) {
+        for (int k = 0; k < 4; ++k) png[at + k] = char(v >> (24 - 8 * k));
+    };
+    put32(ihdr + 4, 900000);
+    put32(ihdr + 8, 900000);
+    put32(ihdr + 17, uint32_t(crc32(0, reinterpret_cast<const Bytef*>(png.data() + ihdr), 17)));
+    test::writeFile(dir + "/huge.png", png);
+    EXPECT_NE(readError(dir + "/huge.png").find("the PNG's header gives 900000x900000 pixels"), std::string::npos)
+        << readError(dir + "/huge.png");
+    // A PNG cut short: libpng's reason is in wedge's message (not printed by libpng itself).
+    test::writeFile(dir + "/cut.png", test::readFile(dir + "/a.png").substr(0, 60));
+    EXPECT_NE(readError(dir + "/cut.png").find("corrupt PNG file ("), std::string::npos) << readError(dir + "/cut.png");
 }

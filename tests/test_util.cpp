@@ -50,6 +50,13 @@ void writeFile(const std::string& path, const std::string& text) {
     out << text;
 }
 
+std::string readFile(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    std::ostringstream text;
+    text << in.rdbuf();
+    return text.str();
+}
+
 int runWedge(const std::string& args, std::string* out, std::string* err) {
     std::string dir = tempDir();
     std::string cmd = std::string(WEDGE_BIN) + " " + args + " >" + dir + "/out.txt 2>" + dir + "/err.txt";

@@ -24,6 +24,9 @@ namespace wedge::io {
 
 namespace {
 
+/// The most pixels a read image may have: --resolution's bound, 16384 x 16384.
+constexpr uint64_t kMaxImagePixels = uint64_t(16384) * 16384;
+
 /// Writes through `write(tmpPath)` and renames onto `path`; removes the temporary on failure.
 template <class Fn>
 void atomicWrite(const std::string& path, Fn&& write) {
@@ -179,17 +182,36 @@ Image3f readPng(const std::string& path) {
         std::fclose(fp);
         throw Error(path, "not a PNG file");
     }
-    png_structp png = png_create_read_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
+    // libpng prints its errors to stderr by default ("libpng error: Read Error" before wedge's
+    // own message); this handler keeps the text for wedge's message instead, and drops warnings.
+    struct Failure {
+        std::string message;
+    } failure;
+    auto onError = [](png_structp p, png_const_charp message) {
+        static_cast<Failure*>(png_get_error_ptr(p))->message = message;
+        png_longjmp(p, 1);
+    };
+    png_structp png = png_create_read_struct(PNG_LIBPNG_VER_STRING, &failure, onError, [](png_structp, png_const_charp) {});
     png_infop info = png_create_info_struct(png);
     std::vector<unsigned char> pixels;
+    std::vector<png_bytep> rows;
     if (setjmp(png_jmpbuf(png))) {
         png_destroy_read_struct(&png, &info, nullptr);
         std::fclose(fp);
-        throw Error(path, "corrupt PNG file");
+        throw Error(path, "corrupt PNG file" + (failure.message.empty() ? "" : " (" + failure.message + ")"));
     }
     png_init_io(png, fp);
     png_set_sig_bytes(png, 8);
     png_read_info(png, info);
+    // The header's size is not checked against anything before the pixels are allocated: a
+    // damaged or hostile header could ask for terabytes (libpng allows 1,000,000 per side).
+    if (uint64_t(png_get_image_width(png, info)) * png_get_image_height(png, info) > kMaxImagePixels) {
+        const std::string size = std::to_string(png_get_image_width(png, info)) + "x" +
+                                 std::to_string(png_get_image_height(png, info));
+        png_destroy_read_struct(&png, &info, nullptr);
+        std::fclose(fp);
+        throw Error(path, "the PNG's header gives " + size + " pixels, more than wedge reads (16384x16384)");
+    }
     png_set_strip_16(png);
     png_set_palette_to_rgb(png);
     png_set_gray_to_rgb(png);
@@ -199,7 +221,7 @@ Image3f readPng(const std::string& path) {
     int w = int(png_get_image_width(png, info)), h = int(png_get_image_height(png, info));
     size_t rowBytes = png_get_rowbytes(png, info);
     pixels.resize(rowBytes * h);
-    std::vector<png_bytep> rows(h);
+    rows.resize(h);
     for (int y = 0; y < h; ++y) rows[y] = &pixels[rowBytes * y];
     png_read_image(png, rows.data());
     png_destroy_read_struct(&png, &info, nullptr);
@@ -239,6 +261,14 @@ Image3f readPfm(const std::string& path) {
         throw Error(path, "not a PFM file (bad header)");
     if (scale > 0) throw Error(path, "big-endian PFM is not supported");
     int channels = magic == "PF" ? 3 : 1;
+    // The header's size against the bytes that follow it, before allocating: a damaged header
+    // ("99999 99999") would otherwise ask for 120 GB.
+    const auto dataStart = in.tellg();
+    in.seekg(0, std::ios::end);
+    const uint64_t available = uint64_t(in.tellg() - dataStart);
+    in.seekg(dataStart);
+    if (uint64_t(w) * uint64_t(h) * channels * sizeof(float) > available)
+        throw Error(path, "truncated PFM data (the header gives " + std::to_string(w) + "x" + std::to_string(h) + ")");
     std::vector<float> raw(size_t(w) * h * channels);
     in.read(reinterpret_cast<char*>(raw.data()), raw.size() * sizeof(float));
     if (!in) throw Error(path, "truncated PFM data");
