@@ -250,12 +250,13 @@ TEST(Render, SamplesTracedAgainAreTheSamplesAndFindTheirSlot) {
     for (int y = 0; y < 32; ++y)
         for (int x = 0; x < 32; ++x) {
             // As the method samples: 16 with spans (slopes), then adaptive samples without.
-            render::PixelStats ps;
+            render::SlotPool pool;
+    render::PixelStats ps;
             render::TracedSample first[kTotal], again[kTotal];
             sampler.traceBatch(x, y, 0, kInitial, true, first);
             sampler.traceBatch(x, y, kInitial, kTotal - kInitial, false, first + kInitial);
             int slot[kTotal];
-            for (uint32_t i = 0; i < kTotal; ++i) slot[i] = ps.add(first[i], view, i < kInitial);
+            for (uint32_t i = 0; i < kTotal; ++i) slot[i] = ps.add(first[i], view, i < kInitial, pool);
             // Traced again in other batches, without spans.
             sampler.traceBatch(x, y, 0, 5, false, again);
             sampler.traceBatch(x, y, 5, kTotal - 5, false, again + 5);
@@ -273,7 +274,7 @@ TEST(Render, SamplesTracedAgainAreTheSamplesAndFindTheirSlot) {
                 EXPECT_EQ(ps.slotOf(again[i]), slot[i]) << x << "," << y << " #" << i;
                 secondSlotSamples += slot[i] == 1;
             }
-            twoSurfaces += ps.slot[1].n > 0;
+            twoSurfaces += ps.slot(1).n > 0;
         }
     EXPECT_GT(twoSurfaces, 20);  // the test sees both slots
     EXPECT_GT(secondSlotSamples, 100);
@@ -317,12 +318,13 @@ render::TracedSample surfaceSample(uint32_t object, float light) {
 TEST(Render, MixedPixelsAreToppedUpByTheirRelativeVariance) {
     ViewGeometry view;
     view.focalPixels = 100;
+    render::SlotPool pool;
     render::PixelStats one, mixed, alike, bright;
     for (int i = 0; i < 16; ++i) {
-        one.add(surfaceSample(0, 1.f), view, false);
-        mixed.add(surfaceSample(i % 2, i % 2 ? 1.f : 0.05f), view, false);   // an edge with contrast
-        alike.add(surfaceSample(i % 2, 0.5f), view, false);                  // two surfaces, same light
-        bright.add(surfaceSample(i % 4 == 0, i % 4 == 0 ? 20.f : 0.f), view, false);  // a small bright part
+        one.add(surfaceSample(0, 1.f), view, false, pool);
+        mixed.add(surfaceSample(i % 2, i % 2 ? 1.f : 0.05f), view, false, pool);   // an edge with contrast
+        alike.add(surfaceSample(i % 2, 0.5f), view, false, pool);                  // two surfaces, same light
+        bright.add(surfaceSample(i % 4 == 0, i % 4 == 0 ? 20.f : 0.f), view, false, pool);  // a small bright part
     }
     EXPECT_EQ(one.mixedTopUp(0.01f, 64), 0u);    // one surface: the filters reach it
     EXPECT_EQ(alike.mixedTopUp(0.01f, 64), 0u);  // no variance to remove
@@ -334,6 +336,42 @@ TEST(Render, MixedPixelsAreToppedUpByTheirRelativeVariance) {
     EXPECT_EQ(one.primary(), 0);
 }
 
+TEST(Render, PixelStatsTakeFurtherSlotsOnlyForASecondSurface) {
+    // One surface: no block from the pool, and slots 1.. read as empty. A second surface takes
+    // one block, which the third shares; a fourth goes nowhere. Moving the image of statistics
+    // keeps every pixel's block (the pool stays where it is).
+    ViewGeometry view;
+    view.width = view.height = 2;
+    view.focalPixels = 100;
+    render::PixelStatsImage stats(2, 2);
+    render::SlotPool& pool = stats.pool();
+    auto sample = [](uint32_t object) {
+        render::TracedSample s = surfaceSample(object, 0.5f);
+        s.position = {0, 0, float(object)};
+        return s;
+    };
+    for (int i = 0; i < 10; ++i) EXPECT_EQ(stats(0, 0).add(sample(0), view, false, pool), 0);
+    EXPECT_EQ(pool.blocks(), 0u);
+    EXPECT_EQ(stats(0, 0).slot(1).n, 0u);
+    EXPECT_EQ(stats(0, 0).slot(2).n, 0u);
+    EXPECT_EQ(stats(1, 1).add(sample(0), view, false, pool), 0);
+    EXPECT_EQ(stats(1, 1).add(sample(1), view, false, pool), 1);
+    EXPECT_EQ(pool.blocks(), 1u);
+    EXPECT_EQ(stats(1, 1).add(sample(2), view, false, pool), 2);
+    EXPECT_EQ(stats(1, 1).add(sample(3), view, false, pool), -1);
+    EXPECT_EQ(stats(1, 1).add(sample(1), view, false, pool), 1);
+    EXPECT_EQ(pool.blocks(), 1u);
+    EXPECT_EQ(stats(0, 0).add(sample(5), view, false, pool), 1);
+    EXPECT_EQ(pool.blocks(), 2u);
+    render::PixelStatsImage moved = std::move(stats);
+    EXPECT_EQ(moved(1, 1).slot(1).n, 2u);
+    EXPECT_EQ(moved(1, 1).slot(2).n, 1u);
+    EXPECT_EQ(moved(1, 1).slot(1).object, 1u);
+    EXPECT_EQ(moved(0, 0).slot(1).object, 5u);
+    EXPECT_EQ(moved(0, 0).primary(), 0);
+    EXPECT_EQ(moved(1, 1).primary(), 1);
+}
+
 TEST(Render, APixelKeepsItsFirstSurfacesApartAndTheRestAsColour) {
     // Five surfaces and a miss in one pixel: the slot with the most samples is the primary, the
     // other slots become FrameBuffers::other in slot order, and the surfaces beyond the slots go
@@ -342,16 +380,17 @@ TEST(Render, APixelKeepsItsFirstSurfacesApartAndTheRestAsColour) {
     view.width = view.height = 1;
     view.focalPixels = 100;
     const int counts[] = {3, 6, 4, 2, 1};  // samples per surface (objects 0..4)
+    render::SlotPool pool;
     render::PixelStats ps;
     for (uint32_t object = 0; object < 5; ++object)
         for (int i = 0; i < counts[object]; ++i) {
             render::TracedSample s = surfaceSample(object, 0.1f + 0.2f * float(object) + 0.01f * float(i));
             s.albedo = Vec3f(0.2f + 0.1f * float(object));
             s.position = {0, 0, float(object)};  // each on its own plane
-            EXPECT_EQ(ps.add(s, view, false), object < uint32_t(render::PixelStats::kSlots) ? int(object) : -1);
+            EXPECT_EQ(ps.add(s, view, false, pool), object < uint32_t(render::PixelStats::kSlots) ? int(object) : -1);
         }
     render::TracedSample miss;
-    ps.add(miss, view, false);
+    ps.add(miss, view, false, pool);
     ASSERT_GE(render::PixelStats::kSlots, 3);
     FrameBuffers fb(1, 1);
     ps.store(fb, 0, 0, view);
@@ -391,11 +430,12 @@ TEST(Render, DefocusWidthIsTheSmallestCircleOfConfusionAmongTheSamples) {
         return s;
     };
     FrameBuffers fb(1, 1);
+    render::SlotPool pool;
     render::PixelStats near, straddle, inFocus;
     for (int i = 0; i < 8; ++i) {
-        near.add(at(i % 2 ? 1.f : 0.5f), view, true);          // s_u = 5, 15
-        straddle.add(at(i % 2 ? 1.f : 10.f), view, true);      // s_u = 5, -4
-        inFocus.add(at(i % 3 ? 1.f : 2.f), view, true);        // s_u = 5, 0
+        near.add(at(i % 2 ? 1.f : 0.5f), view, true, pool);          // s_u = 5, 15
+        straddle.add(at(i % 2 ? 1.f : 10.f), view, true, pool);      // s_u = 5, -4
+        inFocus.add(at(i % 3 ? 1.f : 2.f), view, true, pool);        // s_u = 5, 0
     }
     near.store(fb, 0, 0, view);
     EXPECT_NEAR(fb.defocus[0], 5.f, 1e-5f);
@@ -404,7 +444,7 @@ TEST(Render, DefocusWidthIsTheSmallestCircleOfConfusionAmongTheSamples) {
     inFocus.store(fb, 0, 0, view);
     EXPECT_NEAR(fb.defocus[0], 0.f, 1e-5f);
     render::PixelStats none;  // no samples with slopes
-    none.add(at(1.f), view, false);
+    none.add(at(1.f), view, false, pool);
     none.store(fb, 0, 0, view);
     EXPECT_EQ(fb.defocus[0], 0.f);
 }
@@ -414,12 +454,13 @@ TEST(Render, BounceFractionAndDistancesComeFromTheInitialSamples) {
     // adaptive samples whose bounces hit at 0.5: those count towards neither.
     ViewGeometry view;
     view.width = view.height = 1;
+    render::SlotPool pool;
     render::PixelStats ps;
     for (int i = 0; i < 20; ++i) {
         render::TracedSample s = surfaceSample(0, 1.f);
         s.bounceHit = i >= 16 || i % 4 != 0;
         s.bounceDistance = s.bounceHit ? (i >= 16 ? 0.5f : float(i + 1)) : kInf;
-        ps.add(s, view, i < 16);
+        ps.add(s, view, i < 16, pool);
     }
     FrameBuffers fb(1, 1);
     ps.store(fb, 0, 0, view);
@@ -427,7 +468,7 @@ TEST(Render, BounceFractionAndDistancesComeFromTheInitialSamples) {
     EXPECT_FLOAT_EQ(fb.zMin[0], 2.f);
     EXPECT_FLOAT_EQ(fb.zMax[0], 16.f);
     render::PixelStats none;  // no bounce hit: no distances, fraction 0
-    none.add(surfaceSample(0, 1.f), view, true);
+    none.add(surfaceSample(0, 1.f), view, true, pool);
     none.store(fb, 0, 0, view);
     EXPECT_EQ(fb.bounced[0], 0.f);
     EXPECT_GE(fb.zMin[0], kInf);
@@ -440,7 +481,7 @@ TEST(Render, EmitterEdgesAndTheirDefocusRimsAreToppedUp) {
     // samples miss the few percent of the blurred emitter that reach them); farther ones, pixels
     // that saw nothing but the emitter and pixels past the target are not.
     const int W = 16, H = 12;
-    Image<render::PixelStats> stats(W, H);
+    render::PixelStatsImage stats(W, H);
     for (int y = 0; y < H; ++y)
         for (int x = 0; x < W; ++x) {
             render::PixelStats& s = stats(x, y);

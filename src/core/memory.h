@@ -60,7 +60,7 @@ using LargeVector = std::vector<T, LargeAllocator<T>>;
 /// in parallel). Its value-less construct() leaves implicit-lifetime types (trivially copyable
 /// and destructible: Vec3f, PixelStats) unwritten. Default member initialisers would otherwise
 /// make std::vector initialise, and so first-touch, every page on one thread before the
-/// parallel fill (measured: the pixel statistics' 146 MB at 512x512 were 6% of a MAAF render's
+/// parallel fill (measured: the pixel statistics' 155 MB at 512x512 were 6% of a MAAF render's
 /// CPU samples in page faults of one serial memset, `perf record`).
 template <class T>
 struct UnwrittenAllocator : LargeAllocator<T> {

@@ -24,7 +24,7 @@ void renderAaf(const MethodContext& ctx, RenderResult& result) {
     // 1. Initial sampling: occluder spans give the shadow slopes (the stage includes first
     // touching the pixel statistics: 0.02-0.33 s at 512x512 on this machine).
     Timer t;
-    Image<PixelStats> stats(W, H);
+    PixelStatsImage stats(W, H);
     {
         Progress progress("aaf initial", uint64_t(W) * H * n0, !ctx.options.quiet);
         result.rays += samplePixels(
@@ -63,7 +63,7 @@ void renderAaf(const MethodContext& ctx, RenderResult& result) {
     }
     storeStats(stats, ctx, fb);
     result.rays += denseEmission(ctx, emitterExtra, fb);
-    stats = Image<PixelStats>();  // freed before the filter's buffers: a lower peak, fewer fresh pages
+    stats = PixelStatsImage();  // freed before the filter's buffers: a lower peak, fewer fresh pages
     result.seconds.add("sampling_adaptive", t.seconds());
     result.seconds.add("sampling", result.seconds.get("sampling_initial") + result.seconds.get("sampling_adaptive"));
 

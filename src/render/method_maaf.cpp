@@ -64,7 +64,9 @@ void renderMaaf(const MethodContext& ctx, RenderResult& result) {
     // kept (below). Refuse before allocating more than the machine has.
     const size_t pixels = size_t(W) * H;
     const size_t accBytes = filter::MaafAccumulator::bytes(W, H, mo.pairs, 1) + filter::MaafAccumulator::bytes(W, H, mo.pairs, 3);
-    const size_t otherBytes = pixels * (sizeof(PixelStats) + size_t(2 * mo.pairs) * 6 * sizeof(float) + 256);
+    // (The pixel statistics at their most: every pixel seeing a second surface.)
+    const size_t otherBytes = pixels * (sizeof(PixelStats) + SlotPool::kBlock * sizeof(SurfaceSlot) +
+                                        size_t(2 * mo.pairs) * 6 * sizeof(float) + 256);
     auto checkMemory = [&](size_t need, const char* what) {
         const size_t avail = availableMemory();
         if (avail > 0 && need > avail)
@@ -94,7 +96,7 @@ void renderMaaf(const MethodContext& ctx, RenderResult& result) {
     // 1. Initial sampling: 16 path samples with occluder spans (the stage includes first
     // touching the pixel statistics, as in AAF).
     Timer t;
-    Image<PixelStats> stats(W, H);
+    PixelStatsImage stats(W, H);
     FrameBuffers& fb = result.buffers;
     LargeVector<filter::MaafSample> initial(retrace ? 0 : pixels * n0);
     {
@@ -227,7 +229,7 @@ void renderMaaf(const MethodContext& ctx, RenderResult& result) {
             const int primary = stats[p].primary();
             // Central component only on both axes (most pixels: the window fit): eq. 23 is the
             // primary surface's plain sums, which the pixel statistics already hold.
-            const render::SurfaceSlot& slot = stats[p].slot[primary];
+            const render::SurfaceSlot& slot = stats[p].slot(primary);
             if (!outer(p)) {
                 if (slot.n > 0) {
                     const float inv = 1.f / float(slot.n), visible = slot.visible * inv;
@@ -264,7 +266,7 @@ void renderMaaf(const MethodContext& ctx, RenderResult& result) {
     // fewer freshly touched pages.
     LargeVector<filter::MaafSample>().swap(initial);  // (= {} would keep the capacity)
     LargeVector<filter::MaafSample>().swap(records);
-    stats = Image<PixelStats>();
+    stats = PixelStatsImage();
     result.extra.emplace_back("maaf_outer_component_pixels", double(outerPixels));
     result.seconds.add("prefilter_accumulation", t.seconds());
     result.seconds.add("prefilter",

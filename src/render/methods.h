@@ -35,7 +35,7 @@ constexpr uint32_t kEmitterEdgeSpp = 256;
 /// within an emitter-seeing pixel's circle of confusion plus one pixel whose samples did not all
 /// see an emitter. Its 16 samples miss the few percent of a (defocused) emitter's light that
 /// reach such a rim pixel, and that light is many times the dark surface's own.
-Image<uint32_t> emitterTopUps(const Image<PixelStats>& stats, uint32_t target);
+Image<uint32_t> emitterTopUps(const PixelStatsImage& stats, uint32_t target);
 
 /// Camera rays per pixel for the emitted light where emitterTopUps applies.
 constexpr uint32_t kEmitterEdgeRays = 1024;
@@ -60,7 +60,7 @@ constexpr uint32_t kMixedSpp = 64;
 void sampleUniform(const MethodContext& ctx, const std::string& label, RenderResult& result);
 
 /// Stores every pixel's statistics into `fb`, with the closed-form unoccluded direct light.
-void storeStats(const Image<PixelStats>& stats, const MethodContext& ctx, FrameBuffers& fb);
+void storeStats(const PixelStatsImage& stats, const MethodContext& ctx, FrameBuffers& fb);
 /// Average samples per pixel of `fb.spp`.
 double averageSpp(const FrameBuffers& fb);
 

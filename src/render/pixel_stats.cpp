@@ -45,7 +45,7 @@ void SurfaceSlot::add(const TracedSample& s, const ViewGeometry& view, bool slop
     }
 }
 
-int PixelStats::add(const TracedSample& s, const ViewGeometry& view, bool slopes) {
+int PixelStats::add(const TracedSample& s, const ViewGeometry& view, bool slopes, SlotPool& pool) {
     ++n;
     const SampleRecord& r = s.record;
     Vec3f l = r.direct + r.indirect;
@@ -63,11 +63,18 @@ int PixelStats::add(const TracedSample& s, const ViewGeometry& view, bool slopes
         suAbsMin = std::min(suAbsMin, std::abs(su));
     }
     if (!s.hit) return -1;
-    for (int k = 0; k < kSlots; ++k)
-        if (slot[k].n == 0 || slot[k].matches(s)) {
-            slot[k].add(s, view, slopes);
+    if (first.n == 0 || first.matches(s)) {
+        first.add(s, view, slopes);
+        return 0;
+    }
+    if (!more) more = pool.allocate();
+    for (int k = 1; k < kSlots; ++k) {
+        SurfaceSlot& sl = more[k - 1];
+        if (sl.n == 0 || sl.matches(s)) {
+            sl.add(s, view, slopes);
             return k;
         }
+    }
     return -1;  // a surface beyond the slots: only in the colour (FrameBuffers::rest)
 }
 
@@ -75,7 +82,7 @@ void PixelStats::store(FrameBuffers& fb, int x, int y, const ViewGeometry& view)
     const size_t p = size_t(y) * fb.width + x;
     const float invN = n > 0 ? 1.f / float(n) : 0.f;
     const int primarySlot = primary();
-    const SurfaceSlot& m = slot[primarySlot];
+    const SurfaceSlot& m = slot(primarySlot);
     fb.color[p] = color * invN;
     fb.emission[p] = emission * invN;
     fb.spp[p] = float(n);
@@ -88,7 +95,7 @@ void PixelStats::store(FrameBuffers& fb, int x, int y, const ViewGeometry& view)
     fb.defocus[p] = suLo > suHi ? 0.f : suAbsMin;
     fb.variance[p] = n > 1 ? std::max(0.f, lumSq * invN - mean * mean) / float(n - 1) : 0.f;
     Vec3f slotLight(0.f);
-    for (const SurfaceSlot& k : slot) slotLight += k.rhoDirect + k.rhoIndirect;
+    for (int k = 0; k < kSlots; ++k) slotLight += slot(k).rhoDirect + slot(k).rhoIndirect;
     fb.rest[p] = (light - slotLight) * invN;
     // Demodulate so that albedo * direct reproduces a slot's mean of albedo_s * direct_s.
     auto demodulate = [](const SurfaceSlot& s, const Vec3f& rho, const Vec3f& plain) {
@@ -117,7 +124,7 @@ void PixelStats::store(FrameBuffers& fb, int x, int y, const ViewGeometry& view)
     for (int k = 0, o = 0; k < kSlots; ++k) {
         if (k == primarySlot) continue;
         FrameBuffers::OtherSurface& other = fb.other[o++];
-        storeSurface(slot[k], other.albedo, other.direct, other.indirect, other.normal, other.position, other.object,
+        storeSurface(slot(k), other.albedo, other.direct, other.indirect, other.normal, other.position, other.object,
                      other.coverage);
     }
     storeSurface(m, fb.albedo, fb.direct, fb.indirect, fb.normal, fb.position, fb.object, fb.coverage);

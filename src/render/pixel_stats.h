@@ -8,11 +8,22 @@
 // primary surfaces, so a silhouette pixel (half bar, half floor, or a defocused edge) is never
 // filtered with one surface's neighbours as if it were all one surface; further surfaces and
 // misses are kept as an unfiltered colour (FrameBuffers::rest).
+//
+// Only the first slot lives in the pixel: the others come from a SlotPool, allocated for the
+// pixels whose samples see a second surface (silhouettes, defocused edges: 5% of cornell's pixels at 512x512, 54% of sponza's). Keeping all
+// three inline made the statistics 592 bytes a pixel (155 MB at 512x512), and this machine pays
+// for memory by the page it first touches: 11% of a MAAF render's CPU samples were the kernel
+// zeroing them (`perf record`, cornell 512x512).
 #pragma once
 
 #include <algorithm>
+#include <array>
+#include <memory>
+
+#include <tbb/concurrent_vector.h>
 
 #include "core/buffers.h"
+#include "core/image.h"
 #include "render/path_sampler.h"
 
 namespace wedge::render {
@@ -40,23 +51,42 @@ struct SurfaceSlot {
     void add(const TracedSample& s, const ViewGeometry& view, bool slopes);
 };
 
+/// What a slot without samples reads as (constant-initialised: no guard in the hot loops).
+inline constexpr SurfaceSlot kEmptySlot{};
+
+/// The surface slots after the first: kSlots - 1 at a time, at addresses that stay put while
+/// other threads allocate (tbb::concurrent_vector never moves its elements). Which block a pixel
+/// gets depends on the threads' order; what is in it does not.
+class SlotPool {
+public:
+    static constexpr int kBlock = FrameBuffers::kOtherSurfaces;
+    SurfaceSlot* allocate() { return m_blocks.emplace_back()->data(); }
+    size_t blocks() const { return m_blocks.size(); }
+
+private:
+    tbb::concurrent_vector<std::array<SurfaceSlot, kBlock>> m_blocks;
+};
+
 struct PixelStats {
     Vec3f color{0.f}, emission{0.f}, light{0.f};  // light: sum of albedo * (direct + indirect)
     float lumSum = 0, lumSq = 0;
     uint32_t n = 0, nEmitter = 0;  // nEmitter: samples that saw an emitter
     float suLo = kInf, suHi = -kInf;  // defocus slopes of every sample added with slopes (all surfaces, misses)
     float suAbsMin = kInf;            // the smallest |defocus slope| among them
-    static constexpr int kSlots = 1 + FrameBuffers::kOtherSurfaces;
-    SurfaceSlot slot[kSlots];
+    static constexpr int kSlots = 1 + SlotPool::kBlock;
+    SurfaceSlot first;            // slot 0
+    SurfaceSlot* more = nullptr;  // slots 1 .. kSlots - 1, from the SlotPool once a second surface is seen
+
+    const SurfaceSlot& slot(int k) const { return k == 0 ? first : more ? more[k - 1] : kEmptySlot; }
 
     /// Adds a sample; returns the surface slot it went to (0 .. kSlots - 1) or -1 (background or
-    /// a surface beyond the slots).
-    int add(const TracedSample& s, const ViewGeometry& view, bool slopes);
+    /// a surface beyond the slots). `pool` supplies the further slots when a second surface shows.
+    int add(const TracedSample& s, const ViewGeometry& view, bool slopes, SlotPool& pool);
     /// The slot with the most samples (the first of equals).
     int primary() const {
         int best = 0;
         for (int k = 1; k < kSlots; ++k)
-            if (slot[k].n > slot[best].n) best = k;
+            if (slot(k).n > slot(best).n) best = k;
         return best;
     }
     /// The slot add() put (or would put) the sample in, once every slot exists or the sample is
@@ -65,7 +95,7 @@ struct PixelStats {
     int slotOf(const TracedSample& s) const {
         if (!s.hit) return -1;
         for (int k = 0; k < kSlots; ++k)
-            if (slot[k].matches(s)) return k;
+            if (slot(k).matches(s)) return k;
         return -1;
     }
     /// Extra samples that bring a pixel partly covering an emitter up to `target`: no filter can
@@ -78,13 +108,30 @@ struct PixelStats {
     /// the relative variance of its mean, var / ((mean^2 + 0.01) n), falls to `tau`, at most up
     /// to `target` samples in all.
     uint32_t mixedTopUp(float tau, uint32_t target) const {
-        if (n == 0 || slot[0].n == n || n >= target) return 0;
+        if (n == 0 || first.n == n || n >= target) return 0;
         float mean = lumSum / float(n), var = std::max(0.f, lumSq / float(n) - mean * mean);
         float need = var / ((mean * mean + 0.01f) * tau);
         return need > float(n) ? uint32_t(std::min(need, float(target))) - n : 0;
     }
     /// Writes this pixel into every plane of `fb`.
     void store(FrameBuffers& fb, int x, int y, const ViewGeometry& view) const;
+};
+
+/// Every pixel's statistics with the pool of their further slots (not copyable: the pixels
+/// point into the pool).
+class PixelStatsImage : public Image<PixelStats> {
+public:
+    PixelStatsImage() = default;
+    PixelStatsImage(int width, int height) : Image<PixelStats>(width, height), m_pool(std::make_unique<SlotPool>()) {}
+    PixelStatsImage(const PixelStatsImage&) = delete;
+    PixelStatsImage& operator=(const PixelStatsImage&) = delete;
+    PixelStatsImage(PixelStatsImage&&) noexcept = default;
+    PixelStatsImage& operator=(PixelStatsImage&&) noexcept = default;
+    SlotPool& pool() { return *m_pool; }
+    const SlotPool& pool() const { return *m_pool; }
+
+private:
+    std::unique_ptr<SlotPool> m_pool;  // on the heap: moving the image leaves the slots where they are
 };
 
 }  // namespace wedge::render

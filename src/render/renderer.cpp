@@ -14,7 +14,7 @@ namespace wedge::render {
 
 std::vector<std::string> methods() { return {"mc", "aaf", "maaf", "atrous"}; }
 
-void storeStats(const Image<PixelStats>& stats, const MethodContext& ctx, FrameBuffers& fb) {
+void storeStats(const PixelStatsImage& stats, const MethodContext& ctx, FrameBuffers& fb) {
     const auto& lights = ctx.scene.desc().lights;
     parallelRows(stats.height(), [&](int y) {
         for (int x = 0; x < stats.width(); ++x) {
@@ -27,7 +27,7 @@ void storeStats(const Image<PixelStats>& stats, const MethodContext& ctx, FrameB
     });
 }
 
-Image<uint32_t> emitterTopUps(const Image<PixelStats>& stats, uint32_t target) {
+Image<uint32_t> emitterTopUps(const PixelStatsImage& stats, uint32_t target) {
     const int W = stats.width(), H = stats.height();
     Image<uint32_t> extra(W, H);
     parallelRows(H, [&](int y) {
@@ -93,7 +93,7 @@ double averageSpp(const FrameBuffers& fb) {
 void sampleUniform(const MethodContext& ctx, const std::string& label, RenderResult& result) {
     const ViewGeometry& view = ctx.view;
     Timer t;  // from the pixel statistics' allocation: first touching them is part of the stage
-    Image<PixelStats> stats(view.width, view.height);
+    PixelStatsImage stats(view.width, view.height);
     Progress progress(label, uint64_t(view.width) * view.height * ctx.spp, !ctx.options.quiet);
     result.rays += samplePixels(
         ctx.sampler, stats, view, [&](int, int) { return SampleRange{0, uint32_t(ctx.spp)}; }, false, true,
@@ -107,7 +107,7 @@ void sampleUniform(const MethodContext& ctx, const std::string& label, RenderRes
         false, [](int, int, const TracedSample&, int) {}, nullptr);
     storeStats(stats, ctx, result.buffers);
     result.rays += denseEmission(ctx, topUp, result.buffers);
-    stats = Image<PixelStats>();
+    stats = PixelStatsImage();
     result.seconds.add("sampling", t.seconds());
 }
 

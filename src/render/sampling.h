@@ -20,9 +20,10 @@ struct SampleRange {
 /// range(x, y) -> SampleRange; sink(x, y, const TracedSample&, int slot) with the surface slot
 /// PixelStats::add put the sample in. Returns the number of rays traced.
 template <class RangeFn, class SinkFn>
-uint64_t samplePixels(const PathSampler& sampler, Image<PixelStats>& stats, const ViewGeometry& view, RangeFn&& range,
+uint64_t samplePixels(const PathSampler& sampler, PixelStatsImage& stats, const ViewGeometry& view, RangeFn&& range,
                       bool span, bool slopes, SinkFn&& sink, Progress* progress) {
     std::atomic<uint64_t> rays{0};
+    SlotPool& pool = stats.pool();
     parallelTiles(stats.width(), stats.height(), 16, [&](int x0, int x1, int y0, int y1) {
         uint64_t localRays = 0, localSamples = 0;
         for (int y = y0; y < y1; ++y)
@@ -34,7 +35,7 @@ uint64_t samplePixels(const PathSampler& sampler, Image<PixelStats>& stats, cons
                     uint32_t n = std::min<uint32_t>(16, r.count - i);
                     sampler.traceBatch(x, y, r.first + i, n, span, batch);
                     for (uint32_t k = 0; k < n; ++k) {
-                        int slot = ps.add(batch[k], view, slopes);
+                        int slot = ps.add(batch[k], view, slopes, pool);
                         sink(x, y, batch[k], slot);
                         localRays += batch[k].rays;
                     }
