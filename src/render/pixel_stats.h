@@ -10,10 +10,11 @@
 // misses are kept as an unfiltered colour (FrameBuffers::rest).
 //
 // Only the first slot lives in the pixel: the others come from a SlotPool, allocated for the
-// pixels whose samples see a second surface (silhouettes, defocused edges: 5% of cornell's pixels at 512x512, 54% of sponza's). Keeping all
-// three inline made the statistics 592 bytes a pixel (155 MB at 512x512), and this machine pays
-// for memory by the page it first touches: 11% of a MAAF render's CPU samples were the kernel
-// zeroing them (`perf record`, cornell 512x512).
+// pixels whose samples see a second surface (silhouettes and defocused edges: 5% of cornell's
+// pixels at 512x512, 54% of sponza's). Keeping all three inline made the statistics 592 bytes
+// a pixel (155 MB at 512x512), and this machine pays for memory by the page it first touches:
+// 11% of a MAAF render's CPU samples were the kernel zeroing them (`perf record`, cornell
+// 512x512).
 #pragma once
 
 #include <algorithm>
