@@ -223,6 +223,34 @@ TEST(Raster, DsDoesNotDependOnTheTessellationAasUses) {
     EXPECT_LT(relMse(b.image, a.image), 1e-4);
 }
 
+TEST(Raster, TheSplitStopsAtItsBudget) {
+    // A quad with an edge in depth that sweeps 400 units sideways over the shutter: at
+    // mid-shutter (the canonical image) it is far off screen, where its depth edge projects
+    // thousands of pixels long, so every child splits to the level limit (the scene's triangle
+    // 4^8 times). The budget stops the split (it was 979K triangles and 2.9 GB on
+    // motion_defocus); the same quad moving slowly splits as before, within the budget.
+    auto sweeping = [](float speed) {
+        scene::SceneDesc d = testScene(64, Vec3f(0.f), 0.f, 3.f, false);
+        d.meshes.clear();
+        for (int i = 0; i < 32; ++i) {
+            scene::TriangleMesh m;
+            scene::appendQuad(m, {-0.6f + 0.03f * float(i), -0.6f, -3}, {1.2f, 0, 0}, {0, 0.3f, -1.2f}, 0);
+            m.velocity = {speed, 0, 0};
+            d.meshes.push_back(m);
+        }
+        return d;
+    };
+    SplitPolicy policy;
+    RasterScene fast(sweeping(400.f), policy), slow(sweeping(0.5f), policy);
+    EXPECT_TRUE(fast.splitBudgetReached);
+    EXPECT_GE(fast.triangles.size(), kMaxSplitTriangles);
+    const size_t subtree = size_t(1) << (2 * kMaxSplits);  // one scene triangle split to the limit
+    EXPECT_LE(fast.triangles.size(), kMaxSplitTriangles + subtree);
+    EXPECT_FALSE(slow.splitBudgetReached);
+    EXPECT_GT(slow.triangles.size(), slow.parents.size());  // split, as blurred and 35 px long
+    EXPECT_LT(slow.triangles.size(), 16 * slow.parents.size());
+}
+
 TEST(Raster, NearPlaneCrossingGeometryKeepsItsSamples) {
     // A floor that runs behind the camera crosses the near plane; the same floor cut just in front
     // of the camera does not. The clipped bounds must not lose a sample, and the reference shading

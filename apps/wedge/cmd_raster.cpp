@@ -120,6 +120,10 @@ void runRaster(const RasterArgs& a) {
     printWarnings(desc);
     applyResolution(desc, a.resolution);
     raster::RasterResult r = raster::renderRaster(desc, options(a, desc));
+    if (r.stats.splitBudgetReached)
+        std::fprintf(stderr, "wedge: warning: %s: the split of blurred triangles stopped at %zu triangles "
+                             "(a very small --split-edge, or fast motion far off screen); the rest are kept whole\n",
+                     a.scene.c_str(), raster::kMaxSplitTriangles);
 
     for (const auto& o : a.outputs) io::writeColor(o, r.image);
     if (!a.referenceOutput.empty()) io::writeColor(a.referenceOutput, r.reference.empty() ? r.image : r.reference);

@@ -169,6 +169,10 @@ RasterScene::RasterScene(const scene::SceneDesc& desc, const SplitPolicy& policy
             t.parent = parent = uint32_t(parents.size());
             parents.push_back(t);
         }
+        if (split && triangles.size() >= kMaxSplitTriangles) {
+            split = false;
+            splitBudgetReached = true;
+        }
         if (split) {
             SplitVertex m01 = midpoint(v[0], v[1], smooth), m12 = midpoint(v[1], v[2], smooth),
                         m20 = midpoint(v[2], v[0], smooth);

@@ -329,6 +329,7 @@ public:
         s.spp = m_vis.spp;
         s.triangles = m_scene.triangles.size();
         s.culledTriangles = m_scene.culledTriangles;
+        s.splitBudgetReached = m_scene.splitBudgetReached;
         s.maxTriangleEdge = m_opt.maxTriangleEdge;
         for (size_t i = 0; i < m_scene.triangles.size(); ++i)
             if (!m_scene.triangles[i].nearSafe) {

@@ -67,6 +67,7 @@ struct RasterStats {
     size_t cacheEntries = 0;
     int width = 0, height = 0, spp = 0;
     size_t triangles = 0, culledTriangles = 0, fallbackTriangles = 0;
+    bool splitBudgetReached = false;  // RasterScene::splitBudgetReached
     float maxTriangleEdge = 0;
     uint64_t samples = 0, visibleSamples = 0, sampleTests = 0, boundRejects = 0, fallbackSamples = 0;
     CacheCounts cache;

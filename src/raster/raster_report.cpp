@@ -32,6 +32,7 @@ nlohmann::json statsJson(const RasterStats& s, const std::string& sceneName) {
     j["triangles"] = s.triangles;
     j["split_edge_px"] = s.maxTriangleEdge;
     j["culled_triangles"] = s.culledTriangles;
+    j["split_budget_reached"] = s.splitBudgetReached;
     j["near_plane_fallback_triangles"] = s.fallbackTriangles;
     j["samples"] = s.samples;
     j["visible_samples"] = s.visibleSamples;
