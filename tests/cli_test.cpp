@@ -148,6 +148,20 @@ TEST(Cli, NumberOutOfRangeNamesItsPath) {
                    "bad.json: lights[0].edge2[2]: invalid JSON: number overflow");
 }
 
+TEST(Cli, CoordinatesBeyondWhatEmbreeTracesAreErrors) {
+    // A sphere of radius 1e20 aborted the process in Embree (`ray.valid()`: a ray origin beyond
+    // 1.8e18); now the scene file names what reaches that far.
+    expectRejected(scene(R"({"type": "sphere", "center": [0, 0, 0], "radius": 1e20, "material": "white"})"),
+                   "bad.json: objects[0]: reaches (-1e+20, -1e+20, -1e+20); wedge renders coordinates within +-1e15");
+    expectRejected(scene(R"({"type": "sphere", "center": [0, 0, 0], "radius": 0.5, "material": "white", "velocity": [1e30, 0, 0]})"),
+                   "bad.json: objects[0]: reaches (1e+30, -0.5, -0.5) over the shutter");
+    expectRejected(scene(kSphere, "\"edge1\": [1, 0, 0]", "\"edge1\": [1e20, 0, 0]"), "bad.json: lights[0]: reaches (1e+20, 2, -0.5)");
+    expectRejected(scene(kSphere, "\"position\": [0, 1, 3]", "\"position\": [0, 1, 3e16]"), "bad.json: camera.position: reaches");
+    std::string dir = tempDir(), err;
+    writeFile(dir + "/far.json", scene(R"({"type": "sphere", "center": [0, 0, 0], "radius": 1e12, "material": "white"})"));
+    EXPECT_EQ(runWedge("render " + dir + "/far.json --quiet -o " + dir + "/far.png", nullptr, &err), 0) << err;
+}
+
 TEST(Cli, MissingSceneFile) {
     std::string err;
     EXPECT_EQ(runWedge("render /nonexistent/room.json --quiet", nullptr, &err), 2);

@@ -67,6 +67,9 @@ struct Transform {
     }
 };
 
+/// The largest scene coordinate (checkExtent) and shutter time wedge accepts.
+constexpr float kMaxCoordinate = 1e15f, kMaxShutterTime = 1e6f;
+
 class SceneParser {
 public:
     SceneParser(std::string file, std::string baseDir) : m_file(std::move(file)), m_baseDir(std::move(baseDir)) {}
@@ -94,6 +97,8 @@ private:
         CameraDesc& cam = m_desc.camera;
         cam.position = c["position"].vec3();
         cam.lookAt = c["look_at"].vec3();
+        checkExtent(c["position"], {cam.position});
+        checkExtent(c["look_at"], {cam.lookAt});
         cam.up = c["up"].vec3();
         Vec3f forward = cam.lookAt - cam.position;
         if (length(forward) <= 0) c["look_at"].fail("must differ from camera.position");
@@ -118,6 +123,8 @@ private:
             cam.shutterOpen = float((*s)[0].number());
             cam.shutterClose = float((*s)[1].number());
             if (!(cam.shutterClose > cam.shutterOpen)) s->fail("expected close > open");
+            if (std::max(std::abs(cam.shutterOpen), std::abs(cam.shutterClose)) > kMaxShutterTime)
+                s->fail("expected times within +-1e6");
         }
         c.finish();
     }
@@ -153,6 +160,8 @@ private:
             light.edge2 = l["edge2"].vec3();
             light.radiance = l["radiance"].color();
             if (light.area() <= 0) l["edge2"].fail("edge1 and edge2 span no area");
+            checkExtent(l, {light.corner, light.corner + light.edge1, light.corner + light.edge2,
+                            light.corner + light.edge1 + light.edge2});
             l.finish();
             m_desc.lights.push_back(light);
             // The light is visible to the camera as an emitter of its own (albedo 0).
@@ -202,12 +211,14 @@ private:
                 s.radius = float(o["radius"].positive());
                 s.material = material(o["material"]);
                 s.velocity = mesh.velocity;
+                checkExtent(o, {s.center - Vec3f(s.radius), s.center + Vec3f(s.radius)}, s.velocity);
                 o.finish();
                 m_desc.spheres.push_back(s);
                 continue;
             } else {
                 o["type"].fail("unknown object type '" + type + "' (expected mesh, quad, box or sphere)");
             }
+            checkExtent(o, mesh.positions, mesh.velocity);
             o.finish();
             m_desc.meshes.push_back(std::move(mesh));
         }
@@ -246,6 +257,23 @@ private:
         const Material& m = m_desc.materials[mat];
         if (!m.isEmitter() || velocity != Vec3f(0.f)) return;  // moving emitters stay visible-only
         m_desc.lights.push_back({corner, e1, e2, m.emission});
+    }
+
+    /// Every point, at the shutter's open and close, within +-kMaxCoordinate. Beyond about 1.8e18
+    /// Embree rejects a ray's origin and direction (an assertion that aborts the process, as a
+    /// sphere of radius 1e20 did), and squared distances overflow float near 1.8e19.
+    void checkExtent(const JsonNode& node, const std::vector<Vec3f>& points, const Vec3f& velocity = Vec3f(0.f)) const {
+        const CameraDesc& cam = m_desc.camera;
+        for (const Vec3f& p : points)
+            for (float t : {cam.shutterOpen, cam.shutterClose}) {
+                const Vec3f q = p + velocity * t;
+                if (!(std::max({std::abs(q.x), std::abs(q.y), std::abs(q.z)}) <= kMaxCoordinate)) {
+                    char v[96];
+                    std::snprintf(v, sizeof v, "(%g, %g, %g)", q.x, q.y, q.z);
+                    node.fail(std::string("reaches ") + v + (velocity == Vec3f(0.f) ? "" : " over the shutter") +
+                              "; wedge renders coordinates within +-1e15");
+                }
+            }
     }
 
     void parseRender(JsonNode r) {
