@@ -1,6 +1,9 @@
 // Metrics module: relMSE, SMAPE, PSNR and SSIM on synthetic images with known answers, and the
 // `wedge compare` command over image files.
 #include <gtest/gtest.h>
+#include <filesystem>
+#include <sstream>
+#include <limits>
 
 #include <cmath>
 #include <fstream>
@@ -282,6 +285,32 @@ TEST(Metrics, Log10MapFloorsAtTheLowEnd) {
     EXPECT_NEAR(l[0], -4.f, 1e-6f);
     EXPECT_NEAR(l[1], -2.f, 1e-6f);
     EXPECT_NEAR(l[2], 1.f, 1e-6f);
+}
+
+TEST(CompareCommand, NonFinitePixelsAreNamedNotAveraged) {
+    // A NaN or infinite pixel made relMSE "nan" with exit code 0; now the file, the count and the
+    // first such pixel are named, in the test image, the reference or --variance-from's image.
+    std::string dir = test::tempDir();
+    Image3f bad = constant(6, 5, 1.f);
+    bad(4, 2).y = std::numeric_limits<float>::quiet_NaN();
+    bad(5, 3).x = std::numeric_limits<float>::infinity();
+    io::writePfm(dir + "/bad.pfm", bad);
+    io::writePfm(dir + "/ok.pfm", constant(6, 5, 1.f));
+    for (const char* args : {"bad.pfm ok.pfm", "ok.pfm bad.pfm", "ok.pfm ok.pfm --variance-from bad.pfm"}) {
+        std::string cmd = "compare";
+        std::istringstream words(args);
+        for (std::string w; words >> w;) {
+            cmd += ' ';
+            if (w.find(".pfm") != std::string::npos) cmd += dir + '/';
+            cmd += w;
+        }
+        std::string out, err;
+        EXPECT_EQ(test::runWedge(cmd + " --heatmap " + dir + "/heat.png", &out, &err), 2) << args;
+        EXPECT_NE(err.find(dir + "/bad.pfm: 2 of 30 pixels are not finite (NaN or infinite), the first at x = 4, y = 2"),
+                  std::string::npos)
+            << err;
+        EXPECT_FALSE(std::filesystem::exists(dir + "/heat.png"));
+    }
 }
 
 TEST(CompareCommand, PrintsJsonAndWritesAHeatMap) {
