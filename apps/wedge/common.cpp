@@ -4,13 +4,14 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <functional>
-#include <optional>
 #include <filesystem>
 #include <fstream>
+#include <functional>
+#include <optional>
 #include <unistd.h>
 
 #include "core/error.h"
+#include "core/image.h"
 
 namespace wedge::app {
 
@@ -20,7 +21,7 @@ void printWarnings(const scene::SceneDesc& desc) {
 
 void applyResolution(scene::SceneDesc& desc, const std::string& resolution) {
     if (resolution.empty()) return;
-    constexpr int kMax = 16384;
+    constexpr int kMax = kMaxImageSide;
     // Digits only (sscanf's %d would take "-3" and overflow on "99999999999"), then the bound.
     auto side = [](const std::string& digits) {
         if (digits.empty() || digits.size() > 6 || digits.find_first_not_of("0123456789") != std::string::npos) return -1;

@@ -16,6 +16,9 @@
 
 namespace wedge {
 
+/// The largest image side wedge renders (--resolution, the scene's camera.resolution) or reads.
+constexpr int kMaxImageSide = 16384;
+
 /// Tag: allocate an image without writing it (for trivially constructible T that the caller
 /// writes entirely, so that the pages are first touched by that write).
 struct NoInit {};

@@ -24,8 +24,8 @@ namespace wedge::io {
 
 namespace {
 
-/// The most pixels a read image may have: --resolution's bound, 16384 x 16384.
-constexpr uint64_t kMaxImagePixels = uint64_t(16384) * 16384;
+/// The most pixels a read image may have: what wedge renders at most.
+constexpr uint64_t kMaxImagePixels = uint64_t(kMaxImageSide) * kMaxImageSide;
 
 /// Writes through `write(tmpPath)` and renames onto `path`; removes the temporary on failure.
 template <class Fn>
@@ -210,7 +210,8 @@ Image3f readPng(const std::string& path) {
                                  std::to_string(png_get_image_height(png, info));
         png_destroy_read_struct(&png, &info, nullptr);
         std::fclose(fp);
-        throw Error(path, "the PNG's header gives " + size + " pixels, more than wedge reads (16384x16384)");
+        throw Error(path, "the PNG's header gives " + size + " pixels, more than wedge reads (" +
+                              std::to_string(kMaxImageSide) + "x" + std::to_string(kMaxImageSide) + ")");
     }
     png_set_strip_16(png);
     png_set_palette_to_rgb(png);

@@ -11,6 +11,7 @@
 #include <sstream>
 
 #include "core/error.h"
+#include "core/image.h"
 #include "io/json_reader.h"
 
 #ifndef WEDGE_SCENES_DIR
@@ -112,7 +113,7 @@ private:
             JsonNode r = res[size_t(i)];
             int v = r.integer();
             if (v <= 0) r.fail("expected a positive resolution");
-            if (v > 16384) r.fail("resolution above 16384 is not supported");
+            if (v > kMaxImageSide) r.fail("resolution above " + std::to_string(kMaxImageSide) + " is not supported");
             (i == 0 ? cam.width : cam.height) = v;
         }
         if (auto a = c.optional("aperture_radius")) cam.apertureRadius = float(a->nonNegative());
