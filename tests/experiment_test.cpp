@@ -20,13 +20,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-std::string slurp(const std::string& path) {
-    std::ifstream in(path, std::ios::binary);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
-}
-
 /// A small experiment in a fresh directory; returns the directory.
 std::string runTinyExperiment(const std::string& extra = "", std::string* err = nullptr) {
     std::string dir = test::tempDir() + "/exp";
@@ -82,7 +75,7 @@ TEST(ExperimentSearch, ToleranceStopsEarly) {
 
 TEST(ExperimentCommand, WritesRowsAndASelfContainedReport) {
     std::string dir = runTinyExperiment("--quiet --repeat 2");
-    auto rows = nlohmann::json::parse(slurp(dir + "/results.json"));
+    auto rows = nlohmann::json::parse(test::readFile(dir + "/results.json"));
     ASSERT_TRUE(rows.is_array());
     std::set<std::string> seen;
     for (const auto& r : rows) {
@@ -148,7 +141,7 @@ TEST(ExperimentCommand, WritesRowsAndASelfContainedReport) {
         EXPECT_EQ(r["anchor"], "atrous");
     }
 
-    std::string html = slurp(dir + "/index.html");
+    std::string html = test::readFile(dir + "/index.html");
     // Self-contained: every image is inline and nothing is loaded from elsewhere.
     std::regex src("src=\"([^\"]*)\"");
     int images = 0;
@@ -165,7 +158,7 @@ TEST(ExperimentCommand, WritesRowsAndASelfContainedReport) {
     EXPECT_NE(html.find("bias&sup2;"), std::string::npos);
     EXPECT_NE(html.find("Where the error sits"), std::string::npos);
     EXPECT_TRUE(fs::is_regular_file(dir + "/table.md"));
-    const std::string table = slurp(dir + "/table.md");
+    const std::string table = test::readFile(dir + "/table.md");
     EXPECT_NE(table.find("| where | background | mixed | edge | penumbra | defocused | interior |"), std::string::npos)
         << table;
 }

@@ -70,13 +70,6 @@ double maxAbsDiff(const Image3f& a, const Image3f& b) {
     return m;
 }
 
-std::string readText(const std::string& path) {
-    std::ifstream in(path);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
-}
-
 /// A small motion + defocus scene file for the command-line tests.
 std::string writeTinySceneFile() {
     std::string dir = test::tempDir();
@@ -430,7 +423,7 @@ TEST(RasterCli, WritesImageAndStats) {
               0)
         << err;
     EXPECT_TRUE(std::filesystem::exists(dir + "/aas.png"));
-    auto j = nlohmann::json::parse(readText(dir + "/s.json"));
+    auto j = nlohmann::json::parse(test::readFile(dir + "/s.json"));
     for (const char* key : {"shaded_quads", "shader_invocations", "hits", "misses", "samples_tested", "seconds",
                             "rel_mse_vs_reference"})
         EXPECT_TRUE(j.contains(key)) << key;
@@ -443,7 +436,7 @@ TEST(RasterCli, SweepWritesCsvAndPlot) {
     std::string err;
     ASSERT_EQ(test::runWedge("raster " + scene + " --spp 2 --sweep-cache 16,64,256 --out " + dir + " -q", nullptr, &err), 0)
         << err;
-    std::string csv = readText(dir + "/sweep.csv");
+    std::string csv = test::readFile(dir + "/sweep.csv");
     EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 4);
     EXPECT_EQ(csv.rfind("cache_entries,ds_shaded_quads", 0), 0u);
     for (const char* f : {"sweep.png", "sweep.json", "ds.png", "aas.png", "reference.png"})

@@ -28,12 +28,6 @@ TempRoot& root() {
     static TempRoot r;
     return r;
 }
-std::string slurp(const fs::path& p) {
-    std::ifstream in(p);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
-}
 }  // namespace
 
 std::string tempDir() {
@@ -61,8 +55,8 @@ int runWedge(const std::string& args, std::string* out, std::string* err) {
     std::string dir = tempDir();
     std::string cmd = std::string(WEDGE_BIN) + " " + args + " >" + dir + "/out.txt 2>" + dir + "/err.txt";
     int status = std::system(cmd.c_str());
-    if (out) *out = slurp(dir + "/out.txt");
-    if (err) *err = slurp(dir + "/err.txt");
+    if (out) *out = readFile(dir + "/out.txt");
+    if (err) *err = readFile(dir + "/err.txt");
     return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
 
