@@ -112,6 +112,11 @@ void BM_MaafFilter(benchmark::State& state) {
     Image<filter::AxisFrame> frames(W, H);
     planeBuffers(fb, frames);
     Image<filter::MaafPixel> stored(W, H);
+    filter::MaafOptions o;
+    o.pairs = pairs;
+    // buildAxis's widths on this plane (one world unit per pixel): the Fourier std times the
+    // spatial scale, no narrower than maxRadius pixels.
+    const float sxFloor = 1.f / float(o.maxRadius);
     filter::WedgeShape wedge;
     wedge.omegaYMax = 0.8;
     wedge.sMin = 0.6;
@@ -127,7 +132,7 @@ void BM_MaafFilter(benchmark::State& state) {
                 m.axis[k].pairs = int(comps.size());
                 for (const auto& c : comps) {
                     m.axis[k].cx[c.p] = float(c.cx);
-                    m.axis[k].sx[c.p] = std::max(float(c.sx) * 2.449490f, 0.1f);  // as buildAxis
+                    m.axis[k].sx[c.p] = std::max(float(c.sx) * o.spatialScale, sxFloor);
                     m.axis[k].weight[c.p] = float((c.p ? 2 : 1) * c.mu);
                     m.axis[k].cy[c.p] = float(c.cy);
                 }
@@ -144,8 +149,6 @@ void BM_MaafFilter(benchmark::State& state) {
         }
         acc.scale(i, 0.25f);
     }
-    filter::MaafOptions o;
-    o.pairs = pairs;
     const Image3f fallback(W, H);
     for (auto _ : state) benchmark::DoNotOptimize(acc.filter(effect, fb, frames, fallback, o));
     state.SetItemsProcessed(state.iterations() * W * H);
