@@ -61,15 +61,15 @@ void registerRender(CLI::App& app) {
     cmd->add_option("--method", args->options.method, "Reconstruction method: " + methodList)
         ->check(CLI::IsMember(render::methods()));
     cmd->add_option("--spp", args->spp, "Samples per pixel (mc, atrous) or initial samples per pixel (aaf, maaf)")
-        ->check(CLI::Range(1, 1 << 20));
-    cmd->add_option("--seed", args->seed, "Random seed (default: the scene's render.seed)")->check(CLI::Range(0LL, 4294967295LL));
-    cmd->add_option("--threads", args->threads, "Worker threads (0: all cores)")->check(CLI::Range(0, 1024));
+        ->check(numberIn(1, 1 << 20));
+    cmd->add_option("--seed", args->seed, "Random seed (default: the scene's render.seed)")->check(numberIn(0, 4294967295.0));
+    cmd->add_option("--threads", args->threads, "Worker threads (0: all cores)")->check(numberIn(0, 1024));
     cmd->add_option("-o,--output", args->outputs, "Output image (.exr with all buffers, .png, .pfm); repeatable");
     cmd->add_option("--stats", args->stats, "Write timings and counts as JSON");
     cmd->add_option("--resolution", args->resolution, "Override the camera resolution, WxH");
     cmd->add_option("--aov", args->options.aovDir, "Write PNG debug maps (filter widths, spp, slopes) into this directory");
     cmd->add_option("--max-extra-spp", args->options.maxExtraSpp, "aaf/maaf: cap on adaptive samples per pixel (default 16; the papers use 100)")
-        ->check(CLI::Range(0, 1 << 16));
+        ->check(numberIn(0, 1 << 16));
     cmd->add_option("--maaf-components", args->options.maafComponents, "maaf: filters per 2D/3D subspace (3, 5 or 7)")
         ->check(CLI::IsMember({3, 5, 7}));
     cmd->add_flag("!--no-focal-fallback", args->options.maafFocalFallback,
