@@ -1,7 +1,14 @@
-// Scene module: geometry conventions of the built Embree scene and the occluder-span query.
+// Scene module: geometry conventions of the built Embree scene, the occluder-span query, and the
+// checks of OBJ and MTL text.
 #include <gtest/gtest.h>
 
+#include <filesystem>
+
+#include "core/error.h"
+#include "scene/obj_check.h"
 #include "scene/scene.h"
+#include "scene/scene_loader.h"
+#include "test_util.h"
 
 using namespace wedge;
 using namespace wedge::scene;
@@ -144,4 +151,135 @@ TEST(Scene, SmoothNormalsBlendShallowFoldsAndKeepCreases) {
     const TriangleMesh crease = tent(90.f);  // a box edge
     for (int i : {0, 1, 2}) EXPECT_NEAR(crease.cornerNormals[i].z, 1.f, 1e-6f) << "corner " << i;
     for (int i : {3, 4, 5}) EXPECT_NEAR(crease.cornerNormals[i].x, -1.f, 1e-6f) << "corner " << i;
+}
+
+// OBJ and MTL text checks (obj_check.h): tinyobjloader reads what is not a number as 0.
+
+namespace {
+
+/// The message of the Error that checkObjText throws on `obj`, or "" if it accepts it.
+std::string objError(const std::string& obj) {
+    try {
+        checkObjText(obj, "s.json: objects[0].file", "m.obj");
+    } catch (const Error& e) {
+        return e.what();
+    }
+    return "";
+}
+
+std::string mtlError(const std::string& mtl) {
+    try {
+        checkMtlText(mtl, "s.json: objects[0].file", "m.mtl");
+    } catch (const Error& e) {
+        return e.what();
+    }
+    return "";
+}
+
+}  // namespace
+
+TEST(ObjCheck, AcceptsWhatTheObjFormatAllows) {
+    const std::string tri = "v 0 0 0\nv 1 0 0\nv 0 1 0\n";
+    EXPECT_EQ(objError(tri + "f 1 2 3\n"), "");
+    EXPECT_EQ(objError("# comment\r\nv +1 .5 1e-3 1\r\nv 1 0 0 0.2 0.3 0.4\r\nv\t0 1 0\r\n  f 1 2 3\r\n"), "")
+        << "CRLF, a leading '+', w, vertex colours, tabs and indentation";
+    EXPECT_EQ(objError(tri + "vt 0 0\nvt 1\nvn 0 0 1\nf 1/1/1 2/2/1 3//1\nf -3 -2 -1\nf 1/1 2/2 3/2 1/1\n"), "")
+        << "every corner form; negative indices count back";
+    EXPECT_EQ(objError(tri + "g box\nusemtl a\ns off\nl 1 2\no thing\n"), "") << "statements wedge ignores";
+}
+
+TEST(ObjCheck, NamesTheLineOfEveryMalformedNumber) {
+    // Each of these rendered without a word before: tinyobjloader read the bad token as 0.
+    const std::string tri = "v 0 0 0\nv 1 0 0\nv 0 1 0\n";
+    EXPECT_EQ(objError("v nan 0 0\n"),
+              "s.json: objects[0].file: 'm.obj' line 1: `v` expects 3 to 7 numbers (x y z [w] [r g b]), and 'nan' is not a finite number within +-3.4e38");
+    EXPECT_NE(objError("v 0 0 inf\n").find("'inf' is not a finite number within +-3.4e38"), std::string::npos);
+    EXPECT_NE(objError("v 0.5.5 0 0\n").find("'0.5.5' is not a finite number within +-3.4e38"), std::string::npos);
+    EXPECT_NE(objError("v 1,5 0 0\n").find("'1,5' is not a finite number within +-3.4e38"), std::string::npos);
+    EXPECT_NE(objError("v 1e999 0 0\n").find("'1e999' is not a finite number within +-3.4e38"), std::string::npos);
+    EXPECT_NE(objError("v 1e39 0 0\n").find("'1e39' is not a finite number within +-3.4e38"), std::string::npos)
+        << "finite as a double, infinite as the float the mesh keeps";
+    EXPECT_EQ(objError("v 3e38 0 0\nv 1 0 0\nv 0 1 0\n"), "");
+    EXPECT_NE(objError("v 0 0\n").find("line 1: `v` expects 3 to 7 numbers (x y z [w] [r g b]), got 2 values"), std::string::npos);
+    EXPECT_NE(objError(tri + "vn 0 0 nan\n").find("line 4: `vn` expects 3 numbers (x y z), and 'nan'"), std::string::npos);
+    EXPECT_NE(objError(tri + "vn 0 1\n").find("line 4: `vn` expects 3 numbers (x y z), got 2 values"), std::string::npos);
+}
+
+TEST(ObjCheck, NamesTheLineOfEveryMalformedFace) {
+    const std::string tri = "v 0 0 0\nv 1 0 0\nv 0 1 0\n";
+    EXPECT_EQ(objError(tri + "f 1 2 x\n"), "s.json: objects[0].file: 'm.obj' line 4: face corner 'x' is not a non-zero integer index");
+    EXPECT_NE(objError(tri + "f 1 2 0\n").find("line 4: face corner '0' is not a non-zero integer index"), std::string::npos);
+    EXPECT_NE(objError(tri + "f 1 2 3/x\n").find("face corner '3/x': 'x' is not a non-zero integer index"), std::string::npos);
+    EXPECT_NE(objError(tri + "f 1 2 3/1/2/4\n").find("face corner '3/1/2/4' is not v, v/t, v//n or v/t/n"), std::string::npos);
+    EXPECT_NE(objError(tri + "f 1 2 3/\n").find("is not v, v/t, v//n or v/t/n"), std::string::npos);
+    EXPECT_NE(objError(tri + "f 1 2\n").find("line 4: a face needs at least 3 corners, got 2"), std::string::npos);
+    // An index names an element defined above the face, as the format says.
+    EXPECT_EQ(objError(tri + "f 1 2 4\nv 0 0 1\n"),
+              "s.json: objects[0].file: 'm.obj' line 4: face corner '4' refers to vertex 4, but 3 `v` lines precede it");
+    EXPECT_NE(objError(tri + "f 1 2 -4\n").find("refers to vertex -4, but 3 `v` lines precede it"), std::string::npos);
+    EXPECT_NE(objError(tri + "vn 0 0 1\nf 1//1 2//1 3//2\n").find("line 5: face corner '3//2' refers to normal 2, but 1 `vn` line precedes it"),
+              std::string::npos);
+}
+
+TEST(ObjCheck, MtlColoursAreOneOrThreeFiniteNumbers) {
+    auto materials = checkMtlText("# c\r\nnewmtl a b\r\nKd 0.5\r\nKe 1 2 3\r\nnewmtl c\nKd 0.1 0.2 0.3\nKe 4\nNs x\nmap_Kd t.png\n", "w", "m.mtl");
+    ASSERT_EQ(materials.size(), 2u) << "statements wedge does not render (Ns, map_Kd) are not checked";
+    EXPECT_EQ(materials[0].name, "a b");
+    EXPECT_TRUE(materials[0].greyKd);
+    EXPECT_FALSE(materials[0].greyKe);
+    EXPECT_FALSE(materials[1].greyKd);
+    EXPECT_TRUE(materials[1].greyKe);
+    EXPECT_FALSE(checkMtlText("newmtl a\nKd 0.5\nKd 0.1 0.2 0.3\n", "w", "m.mtl")[0].greyKd) << "the last Kd counts";
+
+    EXPECT_EQ(mtlError("newmtl a\nKd 0.5 x 0.2\n"),
+              "s.json: objects[0].file: 'm.mtl' line 2: `Kd` expects r g b (or one number for grey), and 'x' is not a finite number within +-3.4e38");
+    EXPECT_NE(mtlError("newmtl a\nKd 0.5 0.5\n").find("line 2: `Kd` expects r g b (or one number for grey), got 2 values"),
+              std::string::npos);
+    EXPECT_NE(mtlError("newmtl a\nKd 1e999 0 0\n").find("'1e999' is not a finite number"), std::string::npos);
+    EXPECT_NE(mtlError("newmtl a\nKe nan 0 0\n").find("'nan' is not a finite number within +-3.4e38"), std::string::npos);
+    EXPECT_NE(mtlError("newmtl a\nKd\n").find("got 0 values"), std::string::npos);
+    EXPECT_NE(mtlError("newmtl a\nKd spectral a.rfl\n").find("line 2: `Kd spectral` colours are not supported; give r g b"),
+              std::string::npos);
+}
+
+TEST(ObjCheck, MtlFilesAreFoundAsTinyobjloaderFindsThem) {
+    std::string dir = test::tempDir();
+    test::writeFile(dir + "/a.mtl", "newmtl a\n");
+    test::writeFile(dir + "/b c.mtl", "newmtl b\n");
+    // Per statement the first name that exists; a name read before is not read again.
+    EXPECT_EQ(mtlFilesOf("mtllib missing.mtl a.mtl other.mtl\nmtllib a.mtl\nmtllib b\\ c.mtl\n", dir),
+              (std::vector<std::string>{dir + "/a.mtl", dir + "/b c.mtl"}));
+    EXPECT_TRUE(mtlFilesOf("mtllib missing.mtl\n", dir).empty());
+}
+
+TEST(ObjCheck, AGreyMtlColourLoadsAsGrey) {
+    // The MTL format reads `Kd 0.5` as 0.5 0.5 0.5; tinyobjloader reads (0.5, 0, 0).
+    std::string dir = test::tempDir();
+    test::writeFile(dir + "/q.obj", "mtllib q.mtl\nv -1 0 -1\nv 1 0 -1\nv 1 0 1\nv -1 0 1\nusemtl g\nf 1 4 3\nusemtl c\nf 1 3 2\n");
+    test::writeFile(dir + "/q.mtl", "newmtl g\nKd 0.5\nKe 2\nnewmtl c\nKd 0.1 0.2 0.3\n");
+    std::vector<Material> materials;
+    TriangleMesh mesh;
+    std::vector<ParallelogramLight> promoted;
+    std::vector<std::string> warnings;
+    loadObj(dir + "/q.obj", "s.json: objects[0].file", -1, materials, mesh, promoted, warnings);
+    ASSERT_EQ(materials.size(), 2u);
+    EXPECT_EQ(materials[0].albedo, Vec3f(0.5f));
+    EXPECT_EQ(materials[0].emission, Vec3f(2.f));
+    EXPECT_EQ(materials[1].albedo, Vec3f(0.1f, 0.2f, 0.3f));
+    EXPECT_EQ(materials[1].emission, Vec3f(0.f));
+}
+
+TEST(ObjCheck, ShippedMeshesPass) {
+    int mtls = 0;
+    for (const char* obj : {"cornell/CornellBox-Original.obj", "cornell/CornellBox-Glossy.obj", "conference/conference.obj",
+                            "sponza/sponza.obj", "bunny/stanford-bunny.obj"}) {
+        const std::string path = scenesDirectory() + "/" + obj, text = test::readFile(path);
+        ASSERT_FALSE(text.empty()) << path;
+        EXPECT_NO_THROW(checkObjText(text, "test", path)) << path;
+        for (const std::string& mtl : mtlFilesOf(text, std::filesystem::path(path).parent_path().string())) {
+            EXPECT_NO_THROW(checkMtlText(test::readFile(mtl), "test", mtl)) << mtl;
+            ++mtls;
+        }
+    }
+    EXPECT_EQ(mtls, 4) << "the two Cornell boxes', conference's and sponza's";
 }

@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "core/error.h"
+#include "io/text_file.h"
 
 namespace wedge::io {
 
@@ -25,13 +26,8 @@ JsonNode::JsonNode(const nlohmann::json& value, std::string file, std::string pa
     : m_value(value), m_file(std::move(file)), m_path(std::move(path)) {}
 
 nlohmann::json JsonNode::parseFile(const std::string& file) {
-    if (!std::filesystem::exists(file)) throw Error(file, "no such file");
     if (std::filesystem::is_directory(file)) throw Error(file, "is a directory, expected a JSON scene file");
-    std::ifstream in(file);
-    if (!in) throw Error(file, "cannot open for reading");
-    std::stringstream ss;
-    ss << in.rdbuf();
-    return parseText(ss.str(), file);
+    return parseText(readTextFile(file), file);
 }
 
 nlohmann::json JsonNode::parseText(const std::string& text, const std::string& file) {
