@@ -66,6 +66,23 @@ TEST(Cli, GoodSceneRenders) {
     for (const char* f : {"a.png", "a.exr", "a.pfm", "s.json"}) EXPECT_TRUE(fs::exists(dir + "/" + f)) << f;
 }
 
+TEST(Cli, TheExrFileIsTheSameOnAnyNumberOfThreads) {
+    // OpenEXR compresses blocks of lines on its own thread pool; the file's bytes, not only the
+    // image, must not depend on --threads.
+    std::string dir = tempDir();
+    writeFile(dir + "/good.json", scene(kSphere));
+    std::string err;
+    for (const char* t : {"1", "2"})
+        ASSERT_EQ(runWedge("render " + dir + "/good.json --method maaf --resolution 64x48 --threads " + t + " -o " + dir + "/t" + t +
+                               ".exr --quiet",
+                           nullptr, &err),
+                  0)
+            << err;
+    const std::string one = readFile(dir + "/t1.exr");
+    EXPECT_GT(one.size(), 1000u);
+    EXPECT_TRUE(one == readFile(dir + "/t2.exr"));
+}
+
 TEST(Cli, AovMapsShowCoverageAndTheUnfilteredShare) {
     // A floor filling the view: one surface everywhere, so the coverage and unfiltered-share maps
     // are uniform; a sphere over the floor adds silhouette pixels that see two surfaces.

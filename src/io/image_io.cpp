@@ -5,6 +5,7 @@
 #include <OpenEXR/ImfHeader.h>
 #include <OpenEXR/ImfInputFile.h>
 #include <OpenEXR/ImfOutputFile.h>
+#include <OpenEXR/ImfThreading.h>
 #include <png.h>
 
 #include <algorithm>
@@ -13,10 +14,13 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <mutex>
 #include <sstream>
+#include <thread>
 #include <unistd.h>
 
 #include "core/error.h"
+#include "core/parallel.h"
 
 namespace fs = std::filesystem;
 
@@ -71,18 +75,37 @@ float srgbDecode(float v) { return v <= 0.04045f ? v / 12.92f : std::pow((v + 0.
 
 // --- EXR -------------------------------------------------------------------------------------
 
+namespace {
+
+/// OpenEXR compresses and decompresses blocks of lines on its own thread pool, which is empty
+/// unless asked for: `wedge render -o x.exr` writes 65 float channels, and at 512x512 their ZIP
+/// compression took 1.43 s on one thread, 0.79 s on two (as long as the 16-spp render itself).
+/// The pool gets the hardware's threads once; a file uses as many as --threads allows.
+int exrThreads() {
+    static std::once_flag once;
+    std::call_once(once, [] { Imf::setGlobalThreadCount(int(std::max(1u, std::thread::hardware_concurrency()))); });
+    return std::max(1, ThreadLimit::current());
+}
+
+/// deflate's fastest level: 0.61 s instead of 0.79 s for those channels on two threads, and a
+/// file 2% larger (27.7 MB against 27.1 MB; the default level 4 or 6 saves nothing more).
+constexpr int kZipLevel = 1;
+
+}  // namespace
+
 void writeExr(const std::string& path, int width, int height, const std::vector<ExrChannel>& channels) {
     atomicWrite(path, [&](const std::string& tmp) {
         try {
             Imf::Header header(width, height);
             header.compression() = Imf::ZIP_COMPRESSION;
+            header.zipCompressionLevel() = kZipLevel;
             Imf::FrameBuffer fb;
             for (const auto& c : channels) {
                 header.channels().insert(c.name, Imf::Channel(Imf::FLOAT));
                 fb.insert(c.name, Imf::Slice(Imf::FLOAT, (char*)c.data, sizeof(float) * c.stride,
                                              sizeof(float) * c.stride * size_t(width)));
             }
-            Imf::OutputFile file(tmp.c_str(), header);
+            Imf::OutputFile file(tmp.c_str(), header, exrThreads());
             file.setFrameBuffer(fb);
             file.writePixels(height);
         } catch (const Error&) {
@@ -96,7 +119,7 @@ void writeExr(const std::string& path, int width, int height, const std::vector<
 ExrImage readExr(const std::string& path) {
     if (!fs::is_regular_file(path)) throw Error(path, "no such file");
     try {
-        Imf::InputFile file(path.c_str());
+        Imf::InputFile file(path.c_str(), exrThreads());
         Imath::Box2i dw = file.header().dataWindow();
         ExrImage img;
         img.width = dw.max.x - dw.min.x + 1;
