@@ -157,23 +157,23 @@ TEST(Scene, SmoothNormalsBlendShallowFoldsAndKeepCreases) {
 
 namespace {
 
-/// The message of the Error that checkObjText throws on `obj`, or "" if it accepts it.
-std::string objError(const std::string& obj) {
+/// The message of the Error that `check` throws, or "" if it throws none.
+template <class Check>
+std::string errorOf(Check&& check) {
     try {
-        checkObjText(obj, "s.json: objects[0].file", "m.obj");
+        check();
     } catch (const Error& e) {
         return e.what();
     }
     return "";
 }
 
+std::string objError(const std::string& obj) {
+    return errorOf([&] { checkObjText(obj, "s.json: objects[0].file", "m.obj"); });
+}
+
 std::string mtlError(const std::string& mtl) {
-    try {
-        checkMtlText(mtl, "s.json: objects[0].file", "m.mtl");
-    } catch (const Error& e) {
-        return e.what();
-    }
-    return "";
+    return errorOf([&] { checkMtlText(mtl, "s.json: objects[0].file", "m.mtl"); });
 }
 
 }  // namespace
