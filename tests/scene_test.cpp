@@ -186,6 +186,7 @@ TEST(ObjCheck, AcceptsWhatTheObjFormatAllows) {
     EXPECT_EQ(objError(tri + "vt 0 0\nvt 1\nvn 0 0 1\nf 1/1/1 2/2/1 3//1\nf -3 -2 -1\nf 1/1 2/2 3/2 1/1\n"), "")
         << "every corner form; negative indices count back";
     EXPECT_EQ(objError(tri + "g box\nusemtl a\ns off\nl 1 2\no thing\n"), "") << "statements wedge ignores";
+    EXPECT_EQ(objError("v 0 0 0 # a\nv 1 0 0 #b\nv 0 1 0\nf 1 2 3 # face\n"), "") << "comments after the numbers";
 }
 
 TEST(ObjCheck, NamesTheLineOfEveryMalformedNumber) {
@@ -196,6 +197,7 @@ TEST(ObjCheck, NamesTheLineOfEveryMalformedNumber) {
     EXPECT_NE(objError("v 0 0 inf\n").find("'inf' is not a finite number within +-3.4e38"), std::string::npos);
     EXPECT_NE(objError("v 0.5.5 0 0\n").find("'0.5.5' is not a finite number within +-3.4e38"), std::string::npos);
     EXPECT_NE(objError("v 1,5 0 0\n").find("'1,5' is not a finite number within +-3.4e38"), std::string::npos);
+    EXPECT_NE(objError("v 1 0 5#b\n").find("'5#b' is not a finite number"), std::string::npos) << "tinyobjloader reads 0";
     EXPECT_NE(objError("v 1e999 0 0\n").find("'1e999' is not a finite number within +-3.4e38"), std::string::npos);
     EXPECT_NE(objError("v 1e39 0 0\n").find("'1e39' is not a finite number within +-3.4e38"), std::string::npos)
         << "finite as a double, infinite as the float the mesh keeps";
@@ -230,6 +232,7 @@ TEST(ObjCheck, MtlColoursAreOneOrThreeFiniteNumbers) {
     EXPECT_FALSE(materials[1].greyKd);
     EXPECT_TRUE(materials[1].greyKe);
     EXPECT_FALSE(checkMtlText("newmtl a\nKd 0.5\nKd 0.1 0.2 0.3\n", "w", "m.mtl")[0].greyKd) << "the last Kd counts";
+    EXPECT_EQ(mtlError("newmtl a # b\nKd 0.5 0.5 0.5 # grey\n"), "");
 
     EXPECT_EQ(mtlError("newmtl a\nKd 0.5 x 0.2\n"),
               "s.json: objects[0].file: 'm.mtl' line 2: `Kd` expects r g b (or one number for grey), and 'x' is not a finite number within +-3.4e38");

@@ -37,7 +37,9 @@ private:
 
 bool isBlank(char c) { return c == ' ' || c == '\t'; }
 
-/// Fills `out` (cleared, its capacity kept: a large OBJ has a million lines) with the tokens.
+/// Fills `out` (cleared, its capacity kept: a large OBJ has a million lines) with the tokens
+/// before one that starts with '#', a comment some exporters append (`v 1 2 3 # corner`).
+/// Inside a token '#' is not a comment: tinyobjloader reads `5#b` as 0, so it must fail.
 void splitTokens(std::string_view line, std::vector<std::string_view>& out) {
     out.clear();
     size_t i = 0;
@@ -45,6 +47,7 @@ void splitTokens(std::string_view line, std::vector<std::string_view>& out) {
         while (i < line.size() && isBlank(line[i])) ++i;
         size_t start = i;
         while (i < line.size() && !isBlank(line[i])) ++i;
+        if (i > start && line[start] == '#') return;
         if (i > start) out.push_back(line.substr(start, i - start));
     }
 }
