@@ -186,7 +186,7 @@ TEST(ObjCheck, AcceptsWhatTheObjFormatAllows) {
     EXPECT_EQ(objError(tri + "vt 0 0\nvt 1\nvn 0 0 1\nf 1/1/1 2/2/1 3//1\nf -3 -2 -1\nf 1/1 2/2 3/2 1/1\n"), "")
         << "every corner form; negative indices count back";
     EXPECT_EQ(objError(tri + "g box\nusemtl a\ns off\nl 1 2\no thing\n"), "") << "statements wedge ignores";
-    EXPECT_EQ(objError("v 0 0 0 # a\nv 1 0 0 #b\nv 0 1 0\nf 1 2 3 # face\n"), "") << "comments after the numbers";
+    EXPECT_EQ(objError("v 0 0 0 # a\nv 1 0 0 #b\nv 0 1 0\nf 1 2 3\n"), "") << "comments after the numbers";
 }
 
 TEST(ObjCheck, NamesTheLineOfEveryMalformedNumber) {
@@ -214,6 +214,8 @@ TEST(ObjCheck, NamesTheLineOfEveryMalformedFace) {
     EXPECT_NE(objError(tri + "f 1 2 3/x\n").find("face corner '3/x': 'x' is not a non-zero integer index"), std::string::npos);
     EXPECT_NE(objError(tri + "f 1 2 3/1/2/4\n").find("face corner '3/1/2/4' is not v, v/t, v//n or v/t/n"), std::string::npos);
     EXPECT_NE(objError(tri + "f 1 2 3/\n").find("is not v, v/t, v//n or v/t/n"), std::string::npos);
+    EXPECT_NE(objError(tri + "f 1 2 3 # c\n").find("face corner '#' is not a non-zero integer index"), std::string::npos)
+        << "tinyobjloader rejects a comment after a face";
     EXPECT_NE(objError(tri + "f 1 2\n").find("line 4: a face needs at least 3 corners, got 2"), std::string::npos);
     // An index names an element defined above the face, as the format says.
     EXPECT_EQ(objError(tri + "f 1 2 4\nv 0 0 1\n"),

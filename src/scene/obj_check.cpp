@@ -39,15 +39,16 @@ bool isBlank(char c) { return c == ' ' || c == '\t'; }
 
 /// Fills `out` (cleared, its capacity kept: a large OBJ has a million lines) with the tokens
 /// before one that starts with '#', a comment some exporters append (`v 1 2 3 # corner`).
-/// Inside a token '#' is not a comment: tinyobjloader reads `5#b` as 0, so it must fail.
-void splitTokens(std::string_view line, std::vector<std::string_view>& out) {
+/// Inside a token '#' is not a comment: tinyobjloader reads `5#b` as 0, so it must fail. Nor
+/// after a face's corners, which tinyobjloader rejects (`comments` false).
+void splitTokens(std::string_view line, std::vector<std::string_view>& out, bool comments = true) {
     out.clear();
     size_t i = 0;
     while (i < line.size()) {
         while (i < line.size() && isBlank(line[i])) ++i;
         size_t start = i;
         while (i < line.size() && !isBlank(line[i])) ++i;
-        if (i > start && line[start] == '#') return;
+        if (comments && i > start && line[start] == '#') return;
         if (i > start) out.push_back(line.substr(start, i - start));
     }
 }
@@ -115,7 +116,7 @@ void checkObjText(std::string_view text, const std::string& where, const std::st
         size_t i = 0;
         while (i < line.size() && isBlank(line[i])) ++i;
         if (i >= line.size() || (line[i] != 'v' && line[i] != 'f')) continue;
-        splitTokens(line, t);
+        splitTokens(line, t, line[i] == 'v');
         if (t[0] == "v") {
             expectNumbers(t, 3, 7, "3 to 7 numbers (x y z [w] [r g b])", src, n);
             ++counts[0];
