@@ -203,6 +203,22 @@ TEST(Raster, ImageDoesNotDependOnCacheSizeOrThreadCount) {
     EXPECT_EQ(a.stats.sampleTests, c.stats.sampleTests);
 }
 
+TEST(Raster, VelocityIsPerUnitOfShutterTime) {
+    // An object moves by velocity x (close - open) over the shutter (scene_desc.h), as in the
+    // ray tracer: half the shutter at the full velocity is the whole shutter at half of it, and
+    // a shutter that opens later is the same shutter.
+    scene::SceneDesc full = testScene(32, {0.6f, 0, 0}, 0.f, 3.f), half = full, later = full, slow = testScene(32, {0.3f, 0, 0}, 0.f, 3.f);
+    half.camera.shutterClose = 0.5f;
+    later.camera.shutterOpen = 2.f;
+    later.camera.shutterClose = 3.f;
+    RasterOptions o = opts(ShadingMode::Adaptive, 256);
+    o.computeReference = false;
+    const Image3f a = renderRaster(full, o).image;
+    EXPECT_EQ(maxAbsDiff(renderRaster(half, o).image, renderRaster(slow, o).image), 0.0);
+    EXPECT_EQ(maxAbsDiff(renderRaster(later, o).image, a), 0.0);
+    EXPECT_GT(maxAbsDiff(renderRaster(half, o).image, a), 0.02) << "the shutter's length was ignored before";
+}
+
 TEST(Raster, DsDoesNotDependOnTheTessellationAasUses) {
     // Splitting serves AAS's per-primitive bounds; DS keys every sample on the scene's triangle, so
     // its counts and image stay those of the unsplit scene (up to float rounding at cell borders).

@@ -1,5 +1,6 @@
 // Render module: the path sampler against closed forms (direct light from a parallelogram,
-// one-bounce indirect in a sphere, the thin-lens circle of confusion) and determinism across
+// one-bounce indirect in a sphere, the thin-lens circle of confusion, the motion blur of a
+// moving emitter) and determinism across
 // thread counts.
 #include <gtest/gtest.h>
 
@@ -193,6 +194,56 @@ TEST(Render, ThinLensDiscMatchesCircleOfConfusion) {
     EXPECT_NEAR(cx, 32.0, 0.5);
     EXPECT_NEAR(cy, 32.0, 0.5);
     EXPECT_NEAR(diameter, coc, 0.04 * coc) << "CoC " << coc << " px";
+}
+
+TEST(Render, MotionBlurIsTheShutterAverage) {
+    // An emissive strip 0.2 wide at depth 4 moves at 0.6 to the right (moving emitters are seen,
+    // not sampled as lights). It is where the scene puts it when the shutter opens and moves by
+    // 0.6 x (close - open) while it is open, so a point of the plane is covered for the share of
+    // the shutter the strip spends over it. Shutter [0, 1]: a trapezoid 0.8 wide with ramps 0.2
+    // wide and a top of 1/3; [2, 3], the same; [0, 0.5]: half the displacement, 0.5 wide, top 2/3.
+    // (The shutter's times were parsed and ignored before: every shutter rendered as [0, 1].)
+    for (auto [open, close] : {std::pair{0.0, 1.0}, std::pair{2.0, 3.0}, std::pair{0.0, 0.5}}) {
+        std::string json = R"({
+          "camera": {"position": [0, 0, 0], "look_at": [0, 0, -1], "up": [0, 1, 0], "fov_y": 10, "resolution": [64, 16],
+                     "shutter": [OPEN, CLOSE]},
+          "materials": {"glow": {"albedo": [0, 0, 0], "emission": [1, 1, 1]}},
+          "lights": [{"type": "parallelogram", "corner": [100, 100, 100], "edge1": [1, 0, 0], "edge2": [0, 0, 1], "radiance": [1, 1, 1]}],
+          "objects": [{"type": "quad", "corner": [-0.4, -1, -4], "edge1": [0.2, 0, 0], "edge2": [0, 2, 0], "material": "glow",
+                       "velocity": [0.6, 0, 0]}],
+          "render": {"spp": 256, "seed": 11, "indirect": false}
+        })";
+        json.replace(json.find("OPEN"), 4, std::to_string(open));
+        json.replace(json.find("CLOSE"), 5, std::to_string(close));
+        render::RenderOptions o;
+        o.quiet = true;
+        render::RenderResult r = renderJson(json, o);
+        render::Camera cam(parse(json).camera);
+        auto covered = [&](double x) {  // the share of the shutter during which the strip covers x
+            const double x0 = -0.4, w = 0.2, d = 0.6 * (close - open);
+            const double s0 = std::max(0.0, (x - x0 - w) / d), s1 = std::min(1.0, (x - x0) / d);
+            return std::max(0.0, s1 - s0);
+        };
+        auto planeX = [&](float px, float py) {  // where the pixel position's ray meets z = -4
+            render::Ray ray = cam.generate(px, py, {0, 0});
+            return double(ray.origin.x) + double(ray.direction.x) * (-4.0 - ray.origin.z) / ray.direction.z;
+        };
+        double worst = 0, sumMeasured = 0, sumExpected = 0;
+        for (int x = 0; x < 64; ++x) {
+            double measured = 0, expected = 0;
+            for (int y = 0; y < 16; ++y) {
+                measured += r.color(x, y).x / 16;
+                for (int k = 0; k < 16; ++k) expected += covered(planeX(x + (k + 0.5f) / 16, y + 0.5f)) / (16 * 16);
+            }
+            // 4096 samples per column: the standard error of a share is at most 0.008.
+            worst = std::max(worst, std::abs(measured - expected));
+            sumMeasured += measured;
+            sumExpected += expected;
+        }
+        EXPECT_LT(worst, 0.04) << "shutter [" << open << ", " << close << "]: the largest difference of a column from the trapezoid";
+        EXPECT_GT(sumExpected, 4.0) << "the trapezoid lies in the view (0.2 x 22.9 px per unit = 4.6)";
+        EXPECT_NEAR(sumMeasured, sumExpected, 0.02 * sumExpected) << "shutter [" << open << ", " << close << "]";
+    }
 }
 
 TEST(Render, ThinLensRaysMeetOnTheFocalPlane) {

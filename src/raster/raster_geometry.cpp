@@ -213,12 +213,14 @@ RasterScene::RasterScene(const scene::SceneDesc& desc, const SplitPolicy& policy
         add(add, v, faceNormal, velocity, material, mesh, nw != nullptr, 0, 0);
     };
 
+    // Displacements over the whole shutter (scene_desc.h: velocity is per unit of shutter time).
+    const float shutter = desc.camera.shutterLength();
     uint32_t meshIndex = 0;
     for (const auto& m : desc.meshes) {
         for (size_t f = 0; f < m.triangleCount(); ++f) {
             Vec3f pw[3] = {m.positions[m.indices[3 * f]], m.positions[m.indices[3 * f + 1]],
                            m.positions[m.indices[3 * f + 2]]};
-            addRoot(pw, nullptr, m.velocity, m.materialIds[f], meshIndex);
+            addRoot(pw, nullptr, m.velocity * shutter, m.materialIds[f], meshIndex);
         }
         ++meshIndex;
     }
@@ -229,7 +231,7 @@ RasterScene::RasterScene(const scene::SceneDesc& desc, const SplitPolicy& policy
         for (size_t f = 0; f < idx.size() / 3; ++f) {
             Vec3f pw[3] = {pos[idx[3 * f]], pos[idx[3 * f + 1]], pos[idx[3 * f + 2]]};
             Vec3f nw[3] = {nrm[idx[3 * f]], nrm[idx[3 * f + 1]], nrm[idx[3 * f + 2]]};
-            addRoot(pw, nw, s.velocity, s.material, meshIndex);
+            addRoot(pw, nw, s.velocity * shutter, s.material, meshIndex);
         }
         ++meshIndex;
     }

@@ -82,7 +82,8 @@ Scene::Scene(SceneDesc desc) : m_desc(std::move(desc)) {
             // Embree allocates the buffer with the padding its SIMD loads need.
             auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, s, RTC_FORMAT_FLOAT3,
                                                                   3 * sizeof(float), mesh.positions.size()));
-            Vec3f offset = mesh.velocity * float(s);
+            // Time step 0 at shutter open, 1 at close (rays carry the normalised shutter time).
+            Vec3f offset = mesh.velocity * (float(s) * m_desc.camera.shutterLength());
             for (size_t i = 0; i < mesh.positions.size(); ++i) {
                 Vec3f p = mesh.positions[i] + offset;
                 v[3 * i] = p.x; v[3 * i + 1] = p.y; v[3 * i + 2] = p.z;
@@ -115,7 +116,7 @@ Scene::Scene(SceneDesc desc) : m_desc(std::move(desc)) {
                                                                   4 * sizeof(float), m_desc.spheres.size()));
             for (size_t i = 0; i < m_desc.spheres.size(); ++i) {
                 const Sphere& sp = m_desc.spheres[i];
-                Vec3f c = sp.center + sp.velocity * float(s);
+                Vec3f c = sp.center + sp.velocity * (float(s) * m_desc.camera.shutterLength());
                 v[4 * i] = c.x; v[4 * i + 1] = c.y; v[4 * i + 2] = c.z; v[4 * i + 3] = sp.radius;
                 m_lo = vmin(m_lo, c - Vec3f(sp.radius));
                 m_hi = vmax(m_hi, c + Vec3f(sp.radius));

@@ -27,7 +27,10 @@ struct CameraDesc {
     int width = 512, height = 512;
     float apertureRadius = 0.f;  // world units; 0 = pinhole
     float focusDistance = 1.f;   // along forward
+    /// The shutter, in the unit of time of the objects' `velocity`: an object is where the scene
+    /// puts it when the shutter opens and moves by velocity x (close - open) until it closes.
     float shutterOpen = 0.f, shutterClose = 1.f;
+    float shutterLength() const { return shutterClose - shutterOpen; }
 };
 
 /// A parallelogram area light emitting `radiance` from the side of normalize(cross(edge1, edge2)).
@@ -42,7 +45,8 @@ struct ParallelogramLight {
     float sigma() const { return 0.5f * std::sqrt(area()); }
 };
 
-/// Triangles in world space at shutter open; `velocity` moves the whole mesh over the shutter.
+/// Triangles in world space at shutter open; `velocity` (world units per unit of shutter time)
+/// moves the whole mesh by velocity x CameraDesc::shutterLength() over the shutter.
 struct TriangleMesh {
     std::string name;
     std::vector<Vec3f> positions;

@@ -264,13 +264,14 @@ private:
         m_desc.lights.push_back({corner, e1, e2, m.emission});
     }
 
-    /// Every point, at the shutter's open and close, within +-kMaxCoordinate. Beyond about 1.8e18
+    /// Every point, at the shutter's open and close (moved by velocity x (close - open)), within
+    /// +-kMaxCoordinate. Beyond about 1.8e18
     /// Embree rejects a ray's origin and direction (an assertion that aborts the process, as a
     /// sphere of radius 1e20 did), and squared distances overflow float near 1.8e19.
     void checkExtent(const JsonNode& node, const std::vector<Vec3f>& points, const Vec3f& velocity = Vec3f(0.f)) const {
         const CameraDesc& cam = m_desc.camera;
         for (const Vec3f& p : points)
-            for (float t : {cam.shutterOpen, cam.shutterClose}) {
+            for (float t : {0.f, cam.shutterLength()}) {
                 const Vec3f q = p + velocity * t;
                 if (!(std::max({std::abs(q.x), std::abs(q.y), std::abs(q.z)}) <= kMaxCoordinate)) {
                     char v[96];
