@@ -420,6 +420,25 @@ TEST(RasterTexture, BoxFilteredCheckerIsExact) {
     EXPECT_NEAR(g, 0.5f, 0.05f);
 }
 
+TEST(RasterTexture, UnfilteredItIsTheRayTracersChecker) {
+    // With no footprint the rasterizer's filtered checker is scene::albedoAt, which the ray
+    // tracer samples: both renderers texture a scene alike.
+    scene::Material m{"c", Vec3f(0.8f, 0.6f, 0.4f), Vec3f(0.f), "checker", 3.f};
+    uint32_t state = 12345;
+    auto next = [&] { return float((state = state * 1664525u + 1013904223u) >> 8) / float(1 << 24); };
+    int dark = 0;
+    for (int i = 0; i < 500; ++i) {
+        const Vec3f p(8 * next() - 4, 8 * next() - 4, 8 * next() - 4), n(next() - 0.5f, next() - 0.5f, next() - 0.5f);
+        const Vec3f a = scene::albedoAt(m, p, n);
+        EXPECT_EQ(texturedAlbedo(m, p, n, Vec3f(0.f), Vec3f(0.f)), a) << i;
+        const bool isDark = a == m.albedo * scene::kCheckerDark;
+        EXPECT_TRUE(isDark || a == m.albedo) << i;
+        dark += isDark;
+    }
+    EXPECT_GT(dark, 200);
+    EXPECT_LT(dark, 300);
+}
+
 TEST(RasterShader, PolygonIrradianceOfAHugeLightIsPi) {
     scene::ParallelogramLight l{{-500, -500, 1}, {0, 1000, 0}, {1000, 0, 0}, Vec3f(1.f)};  // faces -z
     EXPECT_NEAR(polygonIrradiance(l, {0, 0, 0}, {0, 0, 1}), kPi, 0.01f);

@@ -5,6 +5,7 @@
 #include <filesystem>
 
 #include "core/error.h"
+#include "scene/checker.h"
 #include "scene/obj_check.h"
 #include "scene/scene.h"
 #include "scene/scene_loader.h"
@@ -100,6 +101,32 @@ TEST(Scene, MotionBlurMovesGeometryOverTheShutter) {
     EXPECT_TRUE(s.intersect({0, 0, 1}, {0, 0, -1}, 0, kInf, 0.f, h));
     EXPECT_FALSE(s.intersect({0, 0, 1}, {0, 0, -1}, 0, kInf, 0.5f, h));   // quad now spans x in [0.5, 1.5]
     EXPECT_TRUE(s.intersect({1, 0, 1}, {0, 0, -1}, 0, kInf, 0.5f, h));
+}
+
+TEST(Scene, TheCheckerMovesWithItsObject) {
+    // A checkered quad moving 1.5 along x over the shutter [0, 2]: the point of the quad a ray
+    // hits at time tau (normalised) sits 1.5 tau further right, and shows the same cell.
+    SceneDesc d;
+    d.materials.push_back({"c", Vec3f(0.5f), Vec3f(0.f), "checker", 1.f});  // cells 1 wide
+    d.lights.push_back({{-0.5f, -0.5f, 5}, {1, 0, 0}, {0, -1, 0}, Vec3f(1.f)});
+    d.camera.shutterOpen = 0.f;
+    d.camera.shutterClose = 2.f;
+    TriangleMesh m;
+    appendQuad(m, {-4, -4, 0}, {8, 0, 0}, {0, 8, 0}, 0);  // normal +z: textured in (x, y)
+    m.velocity = {0.75f, 0, 0};                           // 1.5 over the shutter
+    d.meshes.push_back(m);
+    Scene s(std::move(d));
+    auto albedoAt = [&](float x, float y, float tau) {
+        Hit h;
+        EXPECT_TRUE(s.intersect({x, y, 1}, {0, 0, -1}, 0, kInf, tau, h));
+        return h.albedo;
+    };
+    const Vec3f light(0.5f), dark(0.5f * kCheckerDark);
+    EXPECT_EQ(albedoAt(0.25f, 0.25f, 0.f), light);  // cell [0, 1) x [0, 1)
+    EXPECT_EQ(albedoAt(1.25f, 0.25f, 0.f), dark);   // cell [1, 2) x [0, 1)
+    EXPECT_EQ(albedoAt(0.25f + 0.75f, 0.25f, 0.5f), light) << "the same point of the quad, moved 0.75";
+    EXPECT_EQ(albedoAt(1.25f + 1.5f, 0.25f, 1.f), dark);
+    EXPECT_EQ(albedoAt(1.25f, 0.25f, 0.5f), light) << "a fixed point of space sees the quad slide under it";
 }
 
 TEST(Scene, CornerNormalsAreInterpolatedWithEmbreeBarycentrics) {

@@ -19,12 +19,10 @@ double squareWaveSecondIntegral(double x) {
     return n + (m <= 1.0 ? 0.5 * m * m : 2.0 * m - 0.5 * m * m - 1.0);
 }
 
-float squareWave(float x) { return (int64_t(std::floor(x)) & 1) ? -1.f : 1.f; }
-
 }  // namespace
 
 float boxFilteredSquareWave(float x, float halfWidth) {
-    if (halfWidth < 1e-4f) return squareWave(x);
+    if (halfWidth < 1e-4f) return scene::checkerSquareWave(x);
     if (halfWidth > 1e4f) return 0.f;
     double x0 = double(x) - 2.0 * std::floor(0.5 * double(x)), w = halfWidth;  // sq has period 2
     return float((squareWaveIntegral(x0 + w) - squareWaveIntegral(x0 - w)) / (2.0 * w));
@@ -70,12 +68,11 @@ float filteredChecker(Vec2f uv, Vec2f fa, Vec2f fb) {
 Vec3f texturedAlbedo(const scene::Material& m, const Vec3f& pRest, const Vec3f& faceNormal, const Vec3f& footA,
                      const Vec3f& footB) {
     if (m.texture != "checker") return m.albedo;
-    Vec3f an(std::abs(faceNormal.x), std::abs(faceNormal.y), std::abs(faceNormal.z));
-    int drop = an.x >= an.y && an.x >= an.z ? 0 : (an.y >= an.z ? 1 : 2);
-    int iu = drop == 0 ? 1 : 0, iv = drop == 2 ? 1 : 2;
+    int iu, iv;
+    scene::checkerAxes(faceNormal, iu, iv);
     float s = m.textureScale;
     float c = filteredChecker({pRest[iu] * s, pRest[iv] * s}, {footA[iu] * s, footA[iv] * s}, {footB[iu] * s, footB[iv] * s});
-    return m.albedo * (kCheckerDark + (1.f - kCheckerDark) * c);
+    return m.albedo * (scene::kCheckerDark + (1.f - scene::kCheckerDark) * c);
 }
 
 }  // namespace wedge::raster

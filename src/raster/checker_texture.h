@@ -1,7 +1,5 @@
-// The procedural "checker" texture of the scene format, band-limited over a footprint. Meshes
-// carry no texture coordinates, so a triangle's rest-pose (shutter-open) world position is
-// projected onto the coordinate plane most facing its normal and scaled by texture_scale: one
-// checker cell per 1/texture_scale world units. The checker is 0.5 (1 + sq(u) sq(v)) with sq the
+// The procedural "checker" texture of the scene format (scene/checker.h: its plane, scale and
+// point values), band-limited over a footprint. The checker is 0.5 (1 + sq(u) sq(v)) with sq the
 // +-1 square wave; a separable filter of it is the product of the filtered square waves, which
 // have closed forms: a box needs sq's antiderivative (a triangle wave), a tent (box * box) its
 // second antiderivative (piecewise quadratic). The filter is a tent as wide as twice the footprint
@@ -12,13 +10,12 @@
 #pragma once
 
 #include "core/math.h"
+#include "scene/checker.h"
 #include "scene/scene_desc.h"
 
 namespace wedge::raster {
 
 constexpr int kMaxTextureTaps = 16;
-/// Reflectance of the dark checker cells relative to the material's albedo.
-constexpr float kCheckerDark = 0.2f;
 
 /// sq averaged over [x - halfWidth, x + halfWidth] (the point value for halfWidth -> 0).
 float boxFilteredSquareWave(float x, float halfWidth);

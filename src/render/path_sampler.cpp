@@ -133,7 +133,7 @@ void PathSampler::traceBatch(int x, int y, uint32_t first, uint32_t count, bool 
             normal[k] = facing(hit[k].shadingNormal, geometric[k]);
             TracedSample& o = out[k];
             o.hit = true;
-            o.albedo = mat[k]->albedo;
+            o.albedo = hit[k].albedo;
             o.normal = normal[k];
             o.position = hit[k].position;
             o.depth = m_camera.depth(hit[k].position);
@@ -182,7 +182,7 @@ void PathSampler::traceBatch(int x, int y, uint32_t first, uint32_t count, bool 
         // One cosine-weighted bounce per sample.
         scene::RayPacket bounce;
         for (int k = 0; k < n; ++k) {
-            if (!found[k] || maxComponent(mat[k]->albedo) <= 0) continue;
+            if (!found[k] || maxComponent(hit[k].albedo) <= 0) continue;
             Vec3f dir = Frame(normal[k]).toWorld(cosineHemisphere(uBounce[k].x, uBounce[k].y));
             if (dot(dir, geometric[k]) <= 0) continue;  // into the facet: no light comes that way
             out[k].record.bounceDir = dir;
@@ -196,13 +196,11 @@ void PathSampler::traceBatch(int x, int y, uint32_t first, uint32_t count, bool 
 
         // The bounce hit lit by its own light sample.
         scene::RayPacket shadow2;
-        const scene::Material* m2[K] = {};
         for (int k = 0; k < n; ++k) {
             if (!found2[k]) continue;
             out[k].bounceHit = true;
             out[k].bounceDistance = h2[k].t;
-            m2[k] = &m_scene.material(h2[k].material);
-            if (maxComponent(m2[k]->albedo) <= 0) continue;
+            if (maxComponent(h2[k].albedo) <= 0) continue;
             Vec3f g2 = dot(h2[k].normal, bounce.dir[k]) < 0 ? h2[k].normal : -h2[k].normal;
             l2[k] = sampleLight(h2[k].position, facing(h2[k].shadingNormal, g2), uBounceLight[k], choice[k]);
             if (maxComponent(l2[k].irradiance) <= 0 || dot(l2[k].toLight, g2) <= 0) continue;
@@ -219,7 +217,7 @@ void PathSampler::traceBatch(int x, int y, uint32_t first, uint32_t count, bool 
             if (shadow2.valid[k] && !occ2[k])
                 // Cosine-weighted bounce: (albedo/pi) L cos / (cos/pi) = albedo L, so the
                 // demodulated indirect is the incident radiance L = albedo2 E2 / pi.
-                out[k].record.indirect = m2[k]->albedo * l2[k].irradiance * kInvPi;
+                out[k].record.indirect = h2[k].albedo * l2[k].irradiance * kInvPi;
     }
 }
 

@@ -5,6 +5,7 @@
 #include <string>
 
 #include "core/error.h"
+#include "scene/checker.h"
 
 namespace wedge::scene {
 
@@ -99,7 +100,8 @@ Scene::Scene(SceneDesc desc) : m_desc(std::move(desc)) {
         rtcReleaseGeometry(geom);  // the scene holds the reference now
         if (m_geometry.size() <= id) m_geometry.resize(id + 1);
         m_geometry[id] = {mesh.materialIds.data(), mesh.shapeIds.data(), 0, object, false,
-                          mesh.cornerNormals.size() == mesh.indices.size() ? mesh.cornerNormals.data() : nullptr};
+                          mesh.cornerNormals.size() == mesh.indices.size() ? mesh.cornerNormals.data() : nullptr,
+                          mesh.velocity * m_desc.camera.shutterLength()};
         uint32_t shapes = 0;
         for (uint32_t sId : mesh.shapeIds) shapes = std::max(shapes, sId + 1);
         object += std::max(shapes, 1u);
@@ -140,8 +142,8 @@ Scene::~Scene() {
     if (m_device) rtcReleaseDevice(m_device);
 }
 
-void Scene::fillHit(const Vec3f& org, const Vec3f& dir, float t, unsigned geomID, unsigned primID, const Vec3f& ng,
-                    float u, float v, Hit& hit) const {
+void Scene::fillHit(const Vec3f& org, const Vec3f& dir, float t, float time, unsigned geomID, unsigned primID,
+                    const Vec3f& ng, float u, float v, Hit& hit) const {
     const GeometryInfo& g = m_geometry[geomID];
     hit.t = t;
     hit.position = org + dir * t;
@@ -159,6 +161,15 @@ void Scene::fillHit(const Vec3f& org, const Vec3f& dir, float t, unsigned geomID
     hit.material = g.materialIds ? g.materialIds[primID] : g.material;
     // Spheres: one surface each; meshes: one per shape.
     hit.object = g.object + (g.sphere ? primID : (g.shapeIds ? g.shapeIds[primID] : 0));
+    const Material& m = m_desc.materials[hit.material];
+    if (m.texture.empty()) {
+        hit.albedo = m.albedo;
+    } else {
+        // The texture is attached to the object: look it up where the point was at shutter open.
+        const Vec3f displacement =
+            g.sphere ? m_desc.spheres[primID].velocity * m_desc.camera.shutterLength() : g.displacement;
+        hit.albedo = albedoAt(m, hit.position - displacement * time, hit.normal);
+    }
 }
 
 bool Scene::intersect(const Vec3f& org, const Vec3f& dir, float tNear, float tFar, float time, Hit& hit) const {
@@ -167,7 +178,7 @@ bool Scene::intersect(const Vec3f& org, const Vec3f& dir, float tNear, float tFa
     RTCRayHit rh = makeRayHit(org, dir, tNear, tFar, time);
     rtcIntersect1(m_scene, &ctx, &rh);
     if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
-    fillHit(org, dir, rh.ray.tfar, rh.hit.geomID, rh.hit.primID, Vec3f(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z), rh.hit.u,
+    fillHit(org, dir, rh.ray.tfar, time, rh.hit.geomID, rh.hit.primID, Vec3f(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z), rh.hit.u,
             rh.hit.v, hit);
     return true;
 }
@@ -185,7 +196,7 @@ void Scene::intersect(const RayPacket& rays, Hit hits[RayPacket::kSize], bool fo
     for (int i = 0; i < RayPacket::kSize; ++i) {
         found[i] = rays.valid[i] && rh.hit.geomID[i] != RTC_INVALID_GEOMETRY_ID;
         if (found[i])
-            fillHit(rays.org[i], rays.dir[i], rh.ray.tfar[i], rh.hit.geomID[i], rh.hit.primID[i],
+            fillHit(rays.org[i], rays.dir[i], rh.ray.tfar[i], rays.time[i], rh.hit.geomID[i], rh.hit.primID[i],
                     Vec3f(rh.hit.Ng_x[i], rh.hit.Ng_y[i], rh.hit.Ng_z[i]), rh.hit.u[i], rh.hit.v[i], hits[i]);
     }
 }

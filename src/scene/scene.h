@@ -20,6 +20,7 @@ struct Hit {
     Vec3f shadingNormal;  // unit interpolated corner normal (meshes that have them), else the geometric one
     uint32_t material = 0;
     uint32_t object = 0;  // surface id: one per mesh shape (OBJ group) or primitive, one per sphere
+    Vec3f albedo;         // the material's, textured at the hit (scene/checker.h)
 };
 
 /// Nearest and farthest occluder distances along a segment (t measured from its origin).
@@ -75,8 +76,9 @@ public:
     void occluders(const RayPacket& rays, OccluderSpan spans[RayPacket::kSize]) const;
 
 private:
-    void fillHit(const Vec3f& org, const Vec3f& dir, float t, unsigned geomID, unsigned primID, const Vec3f& ng,
-                 float u, float v, Hit& hit) const;
+    /// `time`: the ray's, normalised over the shutter (0 at open, 1 at close).
+    void fillHit(const Vec3f& org, const Vec3f& dir, float t, float time, unsigned geomID, unsigned primID,
+                 const Vec3f& ng, float u, float v, Hit& hit) const;
 
     struct GeometryInfo {
         const uint32_t* materialIds = nullptr;  // per primitive, or null with a constant material
@@ -85,6 +87,7 @@ private:
         uint32_t object = 0;
         bool sphere = false;
         const Vec3f* cornerNormals = nullptr;  // 3 per primitive, or null: flat shading
+        Vec3f displacement{0.f};  // meshes: over the whole shutter (spheres: their own, by primitive)
     };
 
     SceneDesc m_desc;

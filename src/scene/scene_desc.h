@@ -15,7 +15,7 @@ struct Material {
     std::string name;
     Vec3f albedo{0.8f};
     Vec3f emission{0.f};
-    /// Procedural texture for the rasterizer ("checker" or empty); the ray tracer ignores it.
+    /// Procedural texture ("checker" or empty): scene/checker.h.
     std::string texture;
     float textureScale = 1.f;  // checker cells per world unit
     bool isEmitter() const { return maxComponent(emission) > 0; }
