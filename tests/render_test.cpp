@@ -266,6 +266,19 @@ TEST(Render, ThinLensRaysMeetOnTheFocalPlane) {
     EXPECT_NEAR(px.y, 20.25f, 1e-3f);
 }
 
+TEST(Render, DefaultSamplesPerPixel) {
+    // Without --spp: MC takes the scene's render.spp (256 here; no emitter in view, so no
+    // top-up), à-trous 16 like the filters' initial samples (the README and --help say so).
+    scene::Scene s(parse(kPlaneScene));
+    render::RenderOptions o;
+    o.quiet = true;
+    EXPECT_EQ(render::render(s, o).sppAverage, 256.0);
+    o.method = "atrous";
+    EXPECT_EQ(render::render(s, o).sppAverage, 16.0);
+    o.spp = 8;
+    EXPECT_EQ(render::render(s, o).sppAverage, 8.0);
+}
+
 TEST(Render, ImageIsBitIdenticalOnOneAndTwoThreads) {
     for (const char* method : {"mc", "aaf", "maaf", "atrous"}) {
         render::RenderOptions o;

@@ -60,7 +60,7 @@ void registerRender(CLI::App& app) {
     for (auto& m : render::methods()) methodList += (methodList.empty() ? "" : "|") + m;
     cmd->add_option("--method", args->options.method, "Reconstruction method: " + methodList)
         ->check(CLI::IsMember(render::methods()));
-    cmd->add_option("--spp", args->spp, "Samples per pixel (mc, atrous) or initial samples per pixel (aaf, maaf)")
+    cmd->add_option("--spp", args->spp, "Samples per pixel (mc: default the scene's render.spp; atrous: 16) or initial samples per pixel (aaf, maaf: 16)")
         ->check(numberIn(1, 1 << 20));
     cmd->add_option("--seed", args->seed, "Random seed (default: the scene's render.seed)")->check(numberIn(0, 4294967295.0));
     cmd->add_option("--threads", args->threads, "Worker threads (0: all cores)")->check(numberIn(0, 1024));
