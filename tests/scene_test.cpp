@@ -315,3 +315,40 @@ TEST(ObjCheck, ShippedMeshesPass) {
     }
     EXPECT_EQ(mtls, 4) << "the two Cornell boxes', conference's and sponza's";
 }
+
+TEST(SceneFile, EmittersThatLightNothingAreNamed) {
+    // Only the scene's parallelograms and the emissive quads and OBJ parallelogram faces that do
+    // not move are lights; other emitters are seen but light nothing, which used to pass silently.
+    auto warningsOf = [](const std::string& objects, const std::string& dir = ".") {
+        const std::string json = R"({
+          "camera": {"position": [0, 1, 3], "look_at": [0, 0, 0], "up": [0, 1, 0], "fov_y": 40, "resolution": [8, 8]},
+          "materials": {"white": {"albedo": [0.8, 0.8, 0.8]}, "glow": {"albedo": [0, 0, 0], "emission": [4, 4, 4]}},
+          "lights": [{"type": "parallelogram", "corner": [-0.5, 2, -0.5], "edge1": [1, 0, 0], "edge2": [0, 0, 1], "radiance": [5, 5, 5]}],
+          "objects": [)" + objects + R"(]})";
+        SceneDesc d = parseScene(json, "s.json", dir);
+        std::string all;
+        for (const std::string& w : d.warnings) all += w + "\n";
+        return std::make_pair(all, d.lights.size());
+    };
+    auto [quad, quadLights] = warningsOf(R"({"type": "quad", "corner": [0, 1, 0], "edge1": [1, 0, 0], "edge2": [0, 0, 1], "material": "glow"})");
+    EXPECT_EQ(quad, "");
+    EXPECT_EQ(quadLights, 2u) << "a still emissive quad is a light";
+    auto [sphere, sphereLights] = warningsOf(R"({"type": "sphere", "center": [0, 0, 0], "radius": 0.5, "material": "glow"})");
+    EXPECT_EQ(sphere, "s.json: objects[0]: material 'glow' emits, but a sphere is only seen: it lights nothing (lights are the "
+                      "scene's parallelograms and the emissive quads and OBJ parallelogram faces that do not move)\n");
+    EXPECT_EQ(sphereLights, 1u);
+    EXPECT_NE(warningsOf(R"({"type": "box", "min": [0, 0, 0], "max": [1, 1, 1], "material": "glow"})").first.find("a box is only seen"),
+              std::string::npos);
+    EXPECT_NE(warningsOf(R"({"type": "quad", "corner": [0, 1, 0], "edge1": [1, 0, 0], "edge2": [0, 0, 1], "material": "glow", "velocity": [1, 0, 0]})")
+                  .first.find("a moving quad is only seen"),
+              std::string::npos);
+
+    std::string dir = test::tempDir();
+    test::writeFile(dir + "/lamp.obj", "mtllib lamp.mtl\nv 0 2 0\nv 1 2 0\nv 0 2 1\nv 1 2 1\nusemtl lamp\nf 1 2 3\nf 1 3 4 2\n");
+    test::writeFile(dir + "/lamp.mtl", "newmtl lamp\nKd 0 0 0\nKe 9 9 9\n");
+    auto [obj, objLights] = warningsOf(R"({"type": "mesh", "file": "lamp.obj"})", dir);
+    EXPECT_NE(obj.find("s.json: objects[0].file: '" + dir + "/lamp.obj': 1 emissive face(s) of 'lamp.obj:lamp' are not parallelograms"),
+              std::string::npos)
+        << obj;
+    EXPECT_EQ(objLights, 2u) << "the parallelogram face is a light, the triangle is not";
+}

@@ -44,6 +44,14 @@ Vec3f readScale(JsonNode node) {
     return Vec3f(float(node.positive()));
 }
 
+/// "'a', 'b', 'c' and 2 more": a few names for a warning.
+std::string nameList(const std::vector<std::string>& names) {
+    std::string s;
+    for (size_t i = 0; i < names.size() && i < 3; ++i) s += (i ? ", '" : "'") + names[i] + "'";
+    if (names.size() > 3) s += " and " + std::to_string(names.size() - 3) + " more";
+    return s;
+}
+
 /// Accepts a 4-vertex face as a parallelogram light if v2 = v0 + e1 + e2 up to rounding.
 bool asParallelogram(const Vec3f v[4], ParallelogramLight& light) {
     Vec3f e1 = v[1] - v[0], e2 = v[3] - v[0];
@@ -206,16 +214,20 @@ private:
                 uint32_t mat = material(o["material"]);
                 appendQuad(mesh, corner, e1, e2, mat);
                 promoteIfEmissive(mat, corner, e1, e2, mesh.velocity);
+                if (mesh.velocity != Vec3f(0.f)) warnIfUnlit(o, mat, "a moving quad");
             } else if (type == "box") {
                 Vec3f lo = o["min"].vec3(), hi = o["max"].vec3();
                 if (!(hi.x > lo.x && hi.y > lo.y && hi.z > lo.z)) o["max"].fail("expected max > min in every axis");
-                appendBox(mesh, lo, hi, material(o["material"]));
+                const uint32_t mat = material(o["material"]);
+                appendBox(mesh, lo, hi, mat);
+                warnIfUnlit(o, mat, "a box");
             } else if (type == "sphere") {
                 Sphere s;
                 s.center = o["center"].vec3();
                 s.radius = float(o["radius"].positive());
                 s.material = material(o["material"]);
                 s.velocity = mesh.velocity;
+                warnIfUnlit(o, s.material, "a sphere");
                 checkExtent(o, {s.center - Vec3f(s.radius), s.center + Vec3f(s.radius)}, s.velocity);
                 o.finish();
                 m_desc.spheres.push_back(s);
@@ -249,6 +261,9 @@ private:
         loadObj(p.string(), fileNode.where(), overrideMaterial, m_desc.materials, mesh, promoted, m_desc.warnings);
         for (auto& v : mesh.positions) v = xf.apply(v);
         for (auto& n : mesh.cornerNormals) n = xf.applyNormal(n);
+        if (!promoted.empty() && mesh.velocity != Vec3f(0.f))
+            m_desc.warnings.push_back(o.where() + ": " + std::to_string(promoted.size()) +
+                                      " emissive parallelogram face(s) of a moving mesh are only seen: they light nothing");
         for (auto& l : promoted) {
             Vec3f c0 = xf.apply(l.corner);
             l.edge1 = xf.apply(l.corner + l.edge1) - c0;
@@ -256,6 +271,17 @@ private:
             l.corner = c0;
             if (mesh.velocity == Vec3f(0.f)) m_desc.lights.push_back(l);
         }
+    }
+
+    /// Light comes from the scene's parallelogram lights and from the emissive quads and OBJ
+    /// parallelogram faces that do not move, which become such lights; other emitters are seen
+    /// (their emission is in the image where the camera sees them) but light nothing. Say so.
+    void warnIfUnlit(const JsonNode& o, uint32_t mat, const char* what) {
+        const Material& m = m_desc.materials[mat];
+        if (!m.isEmitter()) return;
+        m_desc.warnings.push_back(o.where() + ": material '" + m.name + "' emits, but " + what +
+                                  " is only seen: it lights nothing (lights are the scene's parallelograms and the "
+                                  "emissive quads and OBJ parallelogram faces that do not move)");
     }
 
     void promoteIfEmissive(uint32_t mat, const Vec3f& corner, const Vec3f& e1, const Vec3f& e2, const Vec3f& velocity) {
@@ -381,15 +407,9 @@ void loadObj(const std::string& path, const std::string& where, int overrideMate
             materials.push_back(mat);
         }
         // Valid input that wedge does not render: say so once per file, naming a few materials.
-        auto list = [](const std::vector<std::string>& names) {
-            std::string s;
-            for (size_t i = 0; i < names.size() && i < 3; ++i) s += (i ? ", '" : "'") + names[i] + "'";
-            if (names.size() > 3) s += " and " + std::to_string(names.size() - 3) + " more";
-            return s;
-        };
         std::string unused;
-        if (!specular.empty()) unused += "the specular terms (Ks) of " + list(specular);
-        if (!textured.empty()) unused += std::string(unused.empty() ? "" : "; ") + "the texture maps of " + list(textured);
+        if (!specular.empty()) unused += "the specular terms (Ks) of " + nameList(specular);
+        if (!textured.empty()) unused += std::string(unused.empty() ? "" : "; ") + "the texture maps of " + nameList(textured);
         if (!unused.empty())
             warnings.push_back(where + ": '" + path + "': " + unused +
                                " are not rendered (surfaces are Lambertian with the MTL's Kd)");
@@ -403,6 +423,8 @@ void loadObj(const std::string& path, const std::string& where, int overrideMate
     for (auto& v : mesh.positions)
         if (!isFinite(v)) throw Error(where, "'" + path + "' has a non-finite vertex coordinate");
 
+    size_t unlitFaces = 0;  // emissive faces that are not parallelograms: seen, not lights
+    std::vector<std::string> unlitMaterials;
     std::vector<uint32_t> idx;  // one face's vertices and normals, reused across faces
     std::vector<Vec3f> vn;      // the file's normals; zero: to be smoothed
     for (size_t shapeIndex = 0; shapeIndex < shapes.size(); ++shapeIndex) {
@@ -438,13 +460,17 @@ void loadObj(const std::string& path, const std::string& where, int overrideMate
             }
             offset += n;
             if (n < 3) continue;
-            if (n == 4 && materials[matId].isEmitter()) {
+            if (materials[matId].isEmitter()) {
                 Vec3f v[4];
-                for (int k = 0; k < 4; ++k) v[k] = mesh.positions[idx[k]];
                 ParallelogramLight light;
-                if (asParallelogram(v, light)) {
+                if (n == 4) for (int k = 0; k < 4; ++k) v[k] = mesh.positions[idx[k]];
+                if (n == 4 && asParallelogram(v, light)) {
                     light.radiance = materials[matId].emission;
                     promoted.push_back(light);
+                } else {
+                    ++unlitFaces;
+                    if (std::find(unlitMaterials.begin(), unlitMaterials.end(), materials[matId].name) == unlitMaterials.end())
+                        unlitMaterials.push_back(materials[matId].name);
                 }
             }
             for (int k = 1; k + 1 < n; ++k) {  // fan triangulation (OBJ faces are convex)
@@ -456,6 +482,11 @@ void loadObj(const std::string& path, const std::string& where, int overrideMate
         }
     }
     if (mesh.indices.empty()) throw Error(where, "'" + path + "' contains no triangles");
+    if (unlitFaces > 0) {
+        warnings.push_back(where + ": '" + path + "': " + std::to_string(unlitFaces) + " emissive face(s) of " + nameList(unlitMaterials) +
+                           " are not parallelograms: they are only seen and light nothing (only parallelogram "
+                           "faces become lights)");
+    }
     // Corners without a `vn` (a scanned mesh has none) shade smoothly across edges under
     // kCreaseDegrees: per-triangle normals of a fine scan differ by tens of degrees between
     // neighbours, which would split every pixel's samples into several surfaces (pixel_stats.h)
