@@ -210,6 +210,13 @@ TEST(Cli, ObjWithBadFaceIndex) {
                    "objects[0].file: '" + dir + "/broken.obj' line 4: face corner '7' refers to vertex 7, but 3 `v` lines precede it");
 }
 
+TEST(Cli, ObjWhoseMtlIsMissingSaysSo) {
+    std::string dir = tempDir();
+    writeFile(dir + "/m.obj", "mtllib nothere.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl a\nf 1 2 3\n");
+    expectRejected(scene(R"({"type": "mesh", "file": ")" + dir + R"(/m.obj"})"),
+                   "has faces without a material (tinyobjloader: Material file [ nothere.mtl ] not found");
+}
+
 TEST(Cli, ObjOrMtlWithAMalformedNumber) {
     // tinyobjloader read these as 0 and the scene rendered; now they are errors naming the line.
     std::string dir = tempDir();

@@ -439,8 +439,14 @@ void loadObj(const std::string& path, const std::string& where, int overrideMate
             } else if (mtl >= 0 && size_t(mtl) < mtlToScene.size()) {
                 matId = mtlToScene[mtl];
             } else {
-                throw Error(where, "'" + path + "': shape '" + shape.name +
-                                       "' has faces without a material (give the object a \"material\")");
+                // tinyobjloader's warnings say why: an MTL not found, a `usemtl` it does not define.
+                std::string why = reader.Warning();
+                while (!why.empty() && (why.back() == '\n' || why.back() == ' ')) why.pop_back();
+                for (char& c : why)
+                    if (c == '\n') c = ';';
+                throw Error(where, "'" + path + "': shape '" + shape.name + "' has faces without a material" +
+                                       (why.empty() ? std::string() : " (tinyobjloader: " + why + ")") +
+                                       "; give the object a \"material\"");
             }
             idx.assign(n, 0);
             vn.assign(n, Vec3f(0.f));
