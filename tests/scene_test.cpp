@@ -252,6 +252,15 @@ TEST(ObjCheck, NamesTheLineOfEveryMalformedFace) {
               std::string::npos);
 }
 
+TEST(ObjCheck, LinesThatAreNoStatementAreNamed) {
+    // tinyobjloader skips them; a mistyped `v` or `f` loses geometry without a word.
+    const std::string tri = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+    EXPECT_EQ(checkObjText(tri + "vp 0.5\ncstype bspline\ng a\no b\ns 1\nusemtl m\nl 1 2\np 1\n", "w", "m.obj"), "");
+    EXPECT_EQ(checkObjText("v 0 0 0\nv1 0 0\n/v 1 0 0\n" + tri, "w", "m.obj"),
+              "'m.obj' line 2: 'v1' is not an OBJ statement (nor are the first words of 1 more lines); skipped");
+    EXPECT_EQ(checkObjText(tri + "3 -2 -1\n", "w", "m.obj"), "'m.obj' line 5: '3' is not an OBJ statement; skipped");
+}
+
 TEST(ObjCheck, MtlColoursAreOneOrThreeFiniteNumbers) {
     auto materials = checkMtlText("# c\r\nnewmtl a b\r\nKd 0.5\r\nKe 1 2 3\r\nnewmtl c\nKd 0.1 0.2 0.3\nKe 4\nNs x\nmap_Kd t.png\n", "w", "m.mtl");
     ASSERT_EQ(materials.size(), 2u) << "statements wedge does not render (Ns, map_Kd) are not checked";

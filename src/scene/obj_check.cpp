@@ -101,8 +101,16 @@ void expectNumbers(const std::vector<std::string_view>& t, size_t min, size_t ma
 
 }  // namespace
 
-void checkObjText(std::string_view text, const std::string& where, const std::string& file) {
+std::string checkObjText(std::string_view text, const std::string& where, const std::string& file) {
+    // The statements of the OBJ format (Wavefront's appendix B1), free-form geometry included.
+    static const std::set<std::string_view> kKnown = {
+        "v",     "vt",    "vn",      "vp",     "cstype", "deg",       "bmat",      "step",  "p",     "l",
+        "f",     "fo",    "curv",    "curv2",  "surf",   "parm",      "trim",      "hole",  "scrv",  "sp",
+        "end",   "con",   "g",       "s",      "mg",     "o",         "bevel",     "c_interp", "d_interp", "lod",
+        "usemtl", "usemap", "mtllib", "maplib", "shadow_obj", "trace_obj", "ctech", "stech", "call", "csh"};
     const Source src{where, file};
+    size_t unknown = 0, firstUnknownLine = 0;
+    std::string firstUnknown;
     LineReader reader(text);
     std::string_view line;
     std::vector<std::string_view> t;
@@ -111,11 +119,20 @@ void checkObjText(std::string_view text, const std::string& where, const std::st
     static const char* kStatement[3] = {"v", "vt", "vn"};
     while (reader.next(line)) {
         const size_t n = reader.number();
-        // Only the statements whose numbers wedge relies on; a cheap test on the first bytes
-        // skips the rest (comments, groups, `usemtl`, `s`) without splitting them.
         size_t i = 0;
         while (i < line.size() && isBlank(line[i])) ++i;
-        if (i >= line.size() || (line[i] != 'v' && line[i] != 'f')) continue;
+        if (i >= line.size() || line[i] == '#') continue;
+        size_t end = i;
+        while (end < line.size() && !isBlank(line[end])) ++end;
+        const std::string_view keyword = line.substr(i, end - i);
+        // Only the statements whose numbers wedge relies on are split and checked.
+        if (keyword != "v" && keyword != "vn" && keyword != "vt" && keyword != "f") {
+            if (!kKnown.count(keyword) && unknown++ == 0) {
+                firstUnknownLine = n;
+                firstUnknown = quoted(keyword);
+            }
+            continue;
+        }
         splitTokens(line, t, line[i] == 'v');
         if (t[0] == "v") {
             expectNumbers(t, 3, 7, "3 to 7 numbers (x y z [w] [r g b])", src, n);
@@ -157,6 +174,12 @@ void checkObjText(std::string_view text, const std::string& where, const std::st
             }
         }
     }
+    if (unknown == 0) return "";
+    // tinyobjloader skips what it does not know; a mistyped `v` or `f` would lose geometry.
+    return "'" + file + "' line " + std::to_string(firstUnknownLine) + ": " + firstUnknown +
+           " is not an OBJ statement" +
+           (unknown > 1 ? " (nor are the first words of " + std::to_string(unknown - 1) + " more lines)" : "") +
+           "; skipped";
 }
 
 std::vector<std::string> mtlFilesOf(std::string_view objText, const std::string& searchDir) {

@@ -18,8 +18,10 @@ namespace wedge::scene {
 /// - `f`: at least 3 corners `v`, `v/t`, `v//n` or `v/t/n` of non-zero integers, the vertex and
 ///   normal naming one defined above the face (negative: counted back from the last one).
 /// What wedge does not use (texture coordinates, groups, smoothing, lines, points) is not
-/// checked beyond what tinyobjloader checks.
-void checkObjText(std::string_view text, const std::string& where, const std::string& file);
+/// checked beyond what tinyobjloader checks. Returns a warning (else "") naming the first line
+/// whose first word is not an OBJ statement (`v1 0 0`, `/v 0 0 0`): tinyobjloader skips such
+/// lines, so a mistyped `v` or `f` silently loses geometry.
+std::string checkObjText(std::string_view text, const std::string& where, const std::string& file);
 
 /// The MTL files an OBJ's `mtllib` statements make tinyobjloader read, in its order: per
 /// statement, the first of its names found in `searchDir` (or the working directory where

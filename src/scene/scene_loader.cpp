@@ -343,13 +343,14 @@ void loadObj(const std::string& path, const std::string& where, int overrideMate
     // error, if any, is the one reported, whichever finished first.
     std::vector<MtlColours> mtlColours;
     std::exception_ptr checkError;
+    std::string objWarning;
     tinyobj::ObjReader reader;
     bool parsed = false;
     tbb::parallel_invoke(
         [&] {
             try {
                 const std::string objText = io::readTextFile(path);
-                checkObjText(objText, where, path);
+                if (std::string w = checkObjText(objText, where, path); !w.empty()) objWarning = where + ": " + w;
                 for (const std::string& mtl : mtlFilesOf(objText, config.mtl_search_path)) {
                     std::vector<MtlColours> c = checkMtlText(io::readTextFile(mtl), where, mtl);
                     mtlColours.insert(mtlColours.end(), c.begin(), c.end());
@@ -360,6 +361,7 @@ void loadObj(const std::string& path, const std::string& where, int overrideMate
         },
         [&] { parsed = reader.ParseFromFile(path, config); });
     if (checkError) std::rethrow_exception(checkError);
+    if (!objWarning.empty()) warnings.push_back(objWarning);
     if (!parsed) throw Error(where, "cannot read OBJ '" + path + "': " + reader.Error());
     const auto& attrib = reader.GetAttrib();
     const auto& shapes = reader.GetShapes();
