@@ -330,21 +330,20 @@ private:
 
 }  // namespace
 
-void loadObj(const std::string& path, const std::string& where, int overrideMaterial, std::vector<Material>& materials,
-             TriangleMesh& mesh, std::vector<ParallelogramLight>& promoted, std::vector<std::string>& warnings) {
-    if (!fs::is_regular_file(path)) throw Error(where, "mesh file '" + path + "' does not exist");
+namespace {
+
+/// tinyobjloader's parse of `path`, with the text checks of obj_check.h run beside it: a
+/// malformed number reads as 0 and a grey MTL colour as red in tinyobjloader, so the check's
+/// error, if any, is the one reported (whichever finished first; on sponza the check takes
+/// 0.12 s, the parse about 0.6 s). `mtlColours`: the MTL materials' grey colours, in order.
+void parseObjChecked(const std::string& path, const std::string& where, tinyobj::ObjReader& reader,
+                     std::vector<MtlColours>& mtlColours, std::vector<std::string>& warnings) {
     tinyobj::ObjReaderConfig config;
     config.triangulate = false;  // keep quads, so that emissive parallelograms can become lights
     config.vertex_color = false;
     config.mtl_search_path = fs::path(path).parent_path().string();
-    // tinyobjloader reads a malformed number as 0 and a grey MTL colour as red: the text is
-    // checked too (obj_check.h), so that such a file is an error naming its line. The check runs
-    // beside tinyobjloader's parse (on sponza it takes 0.12 s, the parse about 0.6 s) and its
-    // error, if any, is the one reported, whichever finished first.
-    std::vector<MtlColours> mtlColours;
     std::exception_ptr checkError;
     std::string objWarning;
-    tinyobj::ObjReader reader;
     bool parsed = false;
     tbb::parallel_invoke(
         [&] {
@@ -363,6 +362,64 @@ void loadObj(const std::string& path, const std::string& where, int overrideMate
     if (checkError) std::rethrow_exception(checkError);
     if (!objWarning.empty()) warnings.push_back(objWarning);
     if (!parsed) throw Error(where, "cannot read OBJ '" + path + "': " + reader.Error());
+}
+
+/// Appends the MTL's materials to the scene's list (named "file.obj:name"); returns the scene
+/// index of each. What wedge does not render (specular terms, texture maps) is named in one
+/// warning per file.
+std::vector<uint32_t> appendMtlMaterials(const std::string& path, const std::string& where, const tinyobj::ObjReader& reader,
+                                         const std::vector<MtlColours>& mtlColours, std::vector<Material>& materials,
+                                         std::vector<std::string>& warnings) {
+    std::vector<uint32_t> mtlToScene;
+    const std::string prefix = fs::path(path).filename().string() + ":";
+    std::vector<std::string> specular, textured;
+    const auto& mtlMaterials = reader.GetMaterials();
+    for (size_t mi = 0; mi < mtlMaterials.size(); ++mi) {
+        const tinyobj::material_t& m = mtlMaterials[mi];
+        if (std::max({m.specular[0], m.specular[1], m.specular[2]}) > 0) specular.push_back(m.name);
+        if (!m.diffuse_texname.empty() || !m.bump_texname.empty() || !m.alpha_texname.empty() || !m.normal_texname.empty())
+            textured.push_back(m.name);
+        Material mat;
+        mat.name = prefix + m.name;
+        mat.albedo = Vec3f(m.diffuse[0], m.diffuse[1], m.diffuse[2]);
+        mat.emission = Vec3f(m.emission[0], m.emission[1], m.emission[2]);
+        // "Kd 0.5" is grey in the MTL format; tinyobjloader reads it as (0.5, 0, 0).
+        if (mtlColours.size() == mtlMaterials.size() && mtlColours[mi].name == m.name) {
+            if (mtlColours[mi].greyKd) mat.albedo = Vec3f(mat.albedo.x);
+            if (mtlColours[mi].greyKe) mat.emission = Vec3f(mat.emission.x);
+        }
+        // The MTL's colours obey the scene file's rules for "albedo" and "emission": a negative
+        // or non-finite albedo would make negative or NaN light, and an albedo above 1 creates
+        // energy (the scene file refuses both).
+        auto bad = [&](const char* key, const Vec3f& c, const char* rule) {
+            char v[96];
+            std::snprintf(v, sizeof v, "%g %g %g", c.x, c.y, c.z);
+            throw Error(where, "'" + path + "': material '" + m.name + "' (its MTL): " + key + " " + rule + ", got " + v);
+        };
+        if (!isFinite(mat.albedo) || std::min({mat.albedo.x, mat.albedo.y, mat.albedo.z}) < 0 || maxComponent(mat.albedo) > 1.f)
+            bad("Kd", mat.albedo, "components must lie in [0, 1]");
+        if (!isFinite(mat.emission) || std::min({mat.emission.x, mat.emission.y, mat.emission.z}) < 0)
+            bad("Ke", mat.emission, "components must be finite and non-negative");
+        mtlToScene.push_back(uint32_t(materials.size()));
+        materials.push_back(mat);
+    }
+    // Valid input that wedge does not render: say so once per file, naming a few materials.
+    std::string unused;
+    if (!specular.empty()) unused += "the specular terms (Ks) of " + nameList(specular);
+    if (!textured.empty()) unused += std::string(unused.empty() ? "" : "; ") + "the texture maps of " + nameList(textured);
+    if (!unused.empty())
+        warnings.push_back(where + ": '" + path + "': " + unused + " are not rendered (surfaces are Lambertian with the MTL's Kd)");
+    return mtlToScene;
+}
+
+}  // namespace
+
+void loadObj(const std::string& path, const std::string& where, int overrideMaterial, std::vector<Material>& materials,
+             TriangleMesh& mesh, std::vector<ParallelogramLight>& promoted, std::vector<std::string>& warnings) {
+    if (!fs::is_regular_file(path)) throw Error(where, "mesh file '" + path + "' does not exist");
+    tinyobj::ObjReader reader;
+    std::vector<MtlColours> mtlColours;
+    parseObjChecked(path, where, reader, mtlColours, warnings);
     const auto& attrib = reader.GetAttrib();
     const auto& shapes = reader.GetShapes();
     size_t faceCount = 0;
@@ -371,51 +428,8 @@ void loadObj(const std::string& path, const std::string& where, int overrideMate
         throw Error(where, "'" + path + "' contains no faces (is it a Wavefront OBJ file?)");
 
     // Materials from the MTL, appended to the scene's list unless overridden.
-    std::vector<uint32_t> mtlToScene;
-    if (overrideMaterial < 0) {
-        std::string prefix = fs::path(path).filename().string() + ":";
-        std::vector<std::string> specular, textured;
-        const auto& mtlMaterials = reader.GetMaterials();
-        for (size_t mi = 0; mi < mtlMaterials.size(); ++mi) {
-            const tinyobj::material_t& m = mtlMaterials[mi];
-            if (std::max({m.specular[0], m.specular[1], m.specular[2]}) > 0) specular.push_back(m.name);
-            if (!m.diffuse_texname.empty() || !m.bump_texname.empty() || !m.alpha_texname.empty() ||
-                !m.normal_texname.empty())
-                textured.push_back(m.name);
-            Material mat;
-            mat.name = prefix + m.name;
-            mat.albedo = Vec3f(m.diffuse[0], m.diffuse[1], m.diffuse[2]);
-            mat.emission = Vec3f(m.emission[0], m.emission[1], m.emission[2]);
-            // "Kd 0.5" is grey in the MTL format; tinyobjloader reads it as (0.5, 0, 0).
-            if (mtlColours.size() == mtlMaterials.size() && mtlColours[mi].name == m.name) {
-                if (mtlColours[mi].greyKd) mat.albedo = Vec3f(mat.albedo.x);
-                if (mtlColours[mi].greyKe) mat.emission = Vec3f(mat.emission.x);
-            }
-            // The MTL's colours obey the scene file's rules for "albedo" and "emission": a
-            // negative or non-finite albedo would make negative or NaN light, and an albedo
-            // above 1 creates energy (the scene file refuses both).
-            auto bad = [&](const char* key, const Vec3f& c, const char* rule) {
-                char v[96];
-                std::snprintf(v, sizeof v, "%g %g %g", c.x, c.y, c.z);
-                throw Error(where, "'" + path + "': material '" + m.name + "' (its MTL): " + key + " " + rule +
-                                       ", got " + v);
-            };
-            if (!isFinite(mat.albedo) || std::min({mat.albedo.x, mat.albedo.y, mat.albedo.z}) < 0 ||
-                maxComponent(mat.albedo) > 1.f)
-                bad("Kd", mat.albedo, "components must lie in [0, 1]");
-            if (!isFinite(mat.emission) || std::min({mat.emission.x, mat.emission.y, mat.emission.z}) < 0)
-                bad("Ke", mat.emission, "components must be finite and non-negative");
-            mtlToScene.push_back(uint32_t(materials.size()));
-            materials.push_back(mat);
-        }
-        // Valid input that wedge does not render: say so once per file, naming a few materials.
-        std::string unused;
-        if (!specular.empty()) unused += "the specular terms (Ks) of " + nameList(specular);
-        if (!textured.empty()) unused += std::string(unused.empty() ? "" : "; ") + "the texture maps of " + nameList(textured);
-        if (!unused.empty())
-            warnings.push_back(where + ": '" + path + "': " + unused +
-                               " are not rendered (surfaces are Lambertian with the MTL's Kd)");
-    }
+    const std::vector<uint32_t> mtlToScene =
+        overrideMaterial < 0 ? appendMtlMaterials(path, where, reader, mtlColours, materials, warnings) : std::vector<uint32_t>{};
 
     size_t vertexCount = attrib.vertices.size() / 3, normalCount = attrib.normals.size() / 3;
     mesh.positions.reserve(mesh.positions.size() + vertexCount);
