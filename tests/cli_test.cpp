@@ -256,7 +256,7 @@ TEST(Cli, MtlTermsThatAreNotRenderedAreNamed) {
     EXPECT_TRUE(fs::exists(dir + "/x.png"));
     EXPECT_NE(err.find("warning: " + dir + "/s.json: objects[0].file: '" + dir + "/quad.obj'"), std::string::npos) << err;
     EXPECT_NE(err.find("specular terms (Ks) of 'shiny'"), std::string::npos) << err;
-    EXPECT_NE(err.find("texture maps of 'shiny'"), std::string::npos) << err;
+    EXPECT_NE(err.find("the diffuse maps of 'shiny' (map_Kd '" + dir + "/wood.png' does not exist)"), std::string::npos) << err;
     EXPECT_EQ(err.find("matte"), std::string::npos) << err;
 
     writeFile(dir + "/quad.mtl", "newmtl shiny\nKd 0.5 0.5 0.5\nnewmtl matte\nKd 0.4 0.4 0.4\n");

@@ -37,8 +37,8 @@ scene::SceneDesc testScene(int size, Vec3f velocity, float aperture, float focus
     d.camera.width = d.camera.height = size;
     d.camera.apertureRadius = aperture;
     d.camera.focusDistance = focus;
-    scene::Material quad{"quad", Vec3f(0.8f, 0.6f, 0.4f), Vec3f(0.f), "checker", 6.f};
-    scene::Material wall{"wall", Vec3f(0.5f, 0.6f, 0.8f), Vec3f(0.f), "checker", 3.f};
+    scene::Material quad{"quad", Vec3f(0.8f, 0.6f, 0.4f), Vec3f(0.f), "checker", 6.f, nullptr};
+    scene::Material wall{"wall", Vec3f(0.5f, 0.6f, 0.8f), Vec3f(0.f), "checker", 3.f, nullptr};
     d.materials = {quad, wall};
     d.lights.push_back({{-2, 2, 1}, {0, 0, -1}, {4, 0, 0}, Vec3f(4.f)});  // faces -y, above the camera
     d.lights.push_back({{-2, -2, 0.5f}, {4, 0, 0}, {0, 4, 0}, Vec3f(1.f)});  // faces +z, towards the scene
@@ -143,7 +143,7 @@ TEST(Raster, CacheCountsMatchAHandCountedTinyCase) {
     d.camera.up = {0, 1, 0};
     d.camera.fovY = 90;
     d.camera.width = d.camera.height = 4;
-    d.materials.push_back({"white", Vec3f(0.5f), Vec3f(0.f), "", 1.f});
+    d.materials.push_back({"white", Vec3f(0.5f), Vec3f(0.f), "", 1.f, nullptr});
     d.lights.push_back({{-1, -1, 3}, {2, 0, 0}, {0, -2, 0}, Vec3f(1.f)});
     scene::TriangleMesh m;
     m.positions = {{-1.5f, -1.5f, 0}, {4, -1.5f, 0}, {-1.5f, 4, 0}};
@@ -423,7 +423,7 @@ TEST(RasterTexture, BoxFilteredCheckerIsExact) {
 TEST(RasterTexture, UnfilteredItIsTheRayTracersChecker) {
     // With no footprint the rasterizer's filtered checker is scene::albedoAt, which the ray
     // tracer samples: both renderers texture a scene alike.
-    scene::Material m{"c", Vec3f(0.8f, 0.6f, 0.4f), Vec3f(0.f), "checker", 3.f};
+    scene::Material m{"c", Vec3f(0.8f, 0.6f, 0.4f), Vec3f(0.f), "checker", 3.f, nullptr};
     uint32_t state = 12345;
     auto next = [&] { return float((state = state * 1664525u + 1013904223u) >> 8) / float(1 << 24); };
     int dark = 0;

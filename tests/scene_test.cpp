@@ -5,6 +5,7 @@
 #include <filesystem>
 
 #include "core/error.h"
+#include "io/image_io.h"
 #include "scene/checker.h"
 #include "scene/obj_check.h"
 #include "scene/scene.h"
@@ -18,7 +19,7 @@ namespace {
 
 SceneDesc oneQuad() {
     SceneDesc d;
-    d.materials.push_back({"white", Vec3f(0.5f), Vec3f(0.f), "", 1.f});
+    d.materials.push_back({"white", Vec3f(0.5f), Vec3f(0.f), "", 1.f, nullptr});
     TriangleMesh m;
     appendQuad(m, {-1, -1, 0}, {2, 0, 0}, {0, 2, 0}, 0);  // normal +z
     d.meshes.push_back(m);
@@ -90,7 +91,7 @@ TEST(Scene, SphereNormalPointsOutward) {
 
 TEST(Scene, MotionBlurMovesGeometryOverTheShutter) {
     SceneDesc d;
-    d.materials.push_back({"white", Vec3f(0.5f), Vec3f(0.f), "", 1.f});
+    d.materials.push_back({"white", Vec3f(0.5f), Vec3f(0.f), "", 1.f, nullptr});
     d.lights.push_back({{-0.5f, -0.5f, 5}, {1, 0, 0}, {0, -1, 0}, Vec3f(1.f)});
     TriangleMesh m;
     appendQuad(m, {-0.5f, -0.5f, 0}, {1, 0, 0}, {0, 1, 0}, 0);
@@ -107,7 +108,7 @@ TEST(Scene, TheCheckerMovesWithItsObject) {
     // A checkered quad moving 1.5 along x over the shutter [0, 2]: the point of the quad a ray
     // hits at time tau (normalised) sits 1.5 tau further right, and shows the same cell.
     SceneDesc d;
-    d.materials.push_back({"c", Vec3f(0.5f), Vec3f(0.f), "checker", 1.f});  // cells 1 wide
+    d.materials.push_back({"c", Vec3f(0.5f), Vec3f(0.f), "checker", 1.f, nullptr});  // cells 1 wide
     d.lights.push_back({{-0.5f, -0.5f, 5}, {1, 0, 0}, {0, -1, 0}, Vec3f(1.f)});
     d.camera.shutterOpen = 0.f;
     d.camera.shutterClose = 2.f;
@@ -131,7 +132,7 @@ TEST(Scene, TheCheckerMovesWithItsObject) {
 
 TEST(Scene, CornerNormalsAreInterpolatedWithEmbreeBarycentrics) {
     SceneDesc d;
-    d.materials.push_back({"white", Vec3f(0.5f), Vec3f(0.f), "", 1.f});
+    d.materials.push_back({"white", Vec3f(0.5f), Vec3f(0.f), "", 1.f, nullptr});
     TriangleMesh m;
     m.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};  // geometric normal +z
     m.indices = {0, 1, 2};
@@ -360,4 +361,110 @@ TEST(SceneFile, EmittersThatLightNothingAreNamed) {
               std::string::npos)
         << obj;
     EXPECT_EQ(objLights, 2u) << "the parallelogram face is a light, the triangle is not";
+}
+
+TEST(SceneFile, ObjDiffuseMapsTextureTheAlbedo) {
+    // A quad with texture coordinates and a 2x2 PNG map_Kd: a hit's albedo is Kd times the
+    // bilinear texel at its (u, v), (0, 0) at the image's bottom left, repeating.
+    std::string dir = test::tempDir();
+    Image3f img(2, 2);
+    img(0, 0) = Vec3f(1, 0, 0);  // top left
+    img(1, 0) = Vec3f(0, 1, 0);
+    img(0, 1) = Vec3f(0, 0, 1);  // bottom left
+    img(1, 1) = Vec3f(1, 1, 1);
+    io::writePng(dir + "/t.png", img);
+    test::writeFile(dir + "/q.obj", "mtllib q.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n"
+                                    "usemtl m\nf 1/1 2/2 3/3 4/4\n");
+    test::writeFile(dir + "/q.mtl", "newmtl m\nKd 0.5 0.5 0.5\nmap_Kd t.png\n");
+    SceneDesc d;
+    std::vector<ParallelogramLight> promoted;
+    loadObj(dir + "/q.obj", "s.json: objects[0].file", -1, d.materials, d.meshes.emplace_back(), promoted, d.warnings);
+    ASSERT_EQ(d.materials.size(), 1u);
+    ASSERT_TRUE(d.materials[0].map);
+    EXPECT_TRUE(d.warnings.empty()) << d.warnings[0];
+    const TextureMap& map = *d.materials[0].map;
+    d.lights.push_back({{0, 0, 5}, {1, 0, 0}, {0, 1, 0}, Vec3f(1.f)});
+    Scene s(std::move(d));
+    auto albedoAt = [&](float x, float y) {
+        Hit h;
+        EXPECT_TRUE(s.intersect({x, y, 1}, {0, 0, -1}, 0, kInf, 0, h));
+        return h.albedo;
+    };
+    auto near = [](const Vec3f& a, const Vec3f& b) { return length(a - b) < 1e-5f; };
+    // Texel centres at u, v = 0.25 and 0.75: exactly the texels, times Kd.
+    EXPECT_TRUE(near(albedoAt(0.25f, 0.75f), map.texels(0, 0) * 0.5f));
+    EXPECT_TRUE(near(albedoAt(0.75f, 0.75f), map.texels(1, 0) * 0.5f));
+    EXPECT_TRUE(near(albedoAt(0.25f, 0.25f), map.texels(0, 1) * 0.5f));
+    EXPECT_TRUE(near(map.texels(0, 1), Vec3f(0, 0, 1))) << "the PNG keeps pure colours";
+    // Between two texel centres: their mean. At the quad's edge (u = 0): the texel and its
+    // repeated neighbour (u = -0.25 is texel 1).
+    EXPECT_TRUE(near(albedoAt(0.5f, 0.75f), (map.texels(0, 0) + map.texels(1, 0)) * 0.25f));
+    EXPECT_TRUE(near(map.lookup({0.f, 0.75f}), (map.texels(0, 0) + map.texels(1, 0)) * 0.5f));
+    EXPECT_TRUE(near(map.lookup({1.25f, 0.75f}), map.texels(0, 0))) << "repeats";
+    EXPECT_TRUE(near(map.lookup({-0.75f, -0.25f}), map.texels(0, 0))) << "repeats below zero";
+}
+
+TEST(SceneFile, DiffuseMapsWedgeCannotReadAreNamed) {
+    std::string dir = test::tempDir();
+    test::writeFile(dir + "/q.obj", "mtllib q.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nusemtl a\nf 1 2 3\nusemtl b\nf 1 3 2\n");
+    test::writeFile(dir + "/q.mtl", "newmtl a\nKd 0.5 0.5 0.5\nmap_Kd wood.jpg\nnewmtl b\nKd 0.5 0.5 0.5\nmap_Kd gone.png\n");
+    std::vector<Material> materials;
+    TriangleMesh mesh;
+    std::vector<ParallelogramLight> promoted;
+    std::vector<std::string> warnings;
+    loadObj(dir + "/q.obj", "w", -1, materials, mesh, promoted, warnings);
+    ASSERT_EQ(warnings.size(), 1u);
+    EXPECT_NE(warnings[0].find("the diffuse maps of 'a' (map_Kd 'wood.jpg': wedge reads PNG textures), 'b' (map_Kd '" + dir +
+                               "/gone.png' does not exist) are not rendered"),
+              std::string::npos)
+        << warnings[0];
+    EXPECT_FALSE(materials[0].map);
+
+    // A PNG map on a file without texture coordinates.
+    Image3f img(1, 1, Vec3f(0.5f));
+    io::writePng(dir + "/t.png", img);
+    test::writeFile(dir + "/q.mtl", "newmtl a\nKd 0.5 0.5 0.5\nmap_Kd t.png\nnewmtl b\nKd 0.5 0.5 0.5\n");
+    materials.clear();
+    warnings.clear();
+    TriangleMesh mesh2;
+    loadObj(dir + "/q.obj", "w", -1, materials, mesh2, promoted, warnings);
+    ASSERT_EQ(warnings.size(), 1u);
+    EXPECT_NE(warnings[0].find("the map_Kd of 'q.obj:a' is not rendered: the file has no texture coordinates (vt)"), std::string::npos)
+        << warnings[0];
+
+    // Options: -s with three numbers scales (u, v); with two, tinyobjloader takes the file name
+    // for the third and loses it, which is an error rather than an untextured material.
+    test::writeFile(dir + "/q.obj", "mtllib q.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nvt 0 0\nusemtl a\nf 1/1 2/1 3/1\n");
+    test::writeFile(dir + "/q.mtl", "newmtl a\nKd 0.5 0.5 0.5\nmap_Kd -s 4 2 1 -o 0.5 0 0 t.png\n");
+    materials.clear();
+    TriangleMesh mesh4;
+    loadObj(dir + "/q.obj", "w", -1, materials, mesh4, promoted, warnings);
+    ASSERT_TRUE(materials[0].map);
+    EXPECT_EQ(materials[0].map->scale.x, 4.f);
+    EXPECT_EQ(materials[0].map->scale.y, 2.f);
+    EXPECT_EQ(materials[0].map->offset.x, 0.5f);
+    test::writeFile(dir + "/q.mtl", "newmtl a\nKd 0.5 0.5 0.5\nmap_Kd -s 4 4 t.png\n");
+    materials.clear();
+    TriangleMesh mesh5;
+    try {
+        loadObj(dir + "/q.obj", "w", -1, materials, mesh5, promoted, warnings);
+        ADD_FAILURE() << "map_Kd -s 4 4 t.png must be an error";
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("material 'a': map_Kd names 't.png', but tinyobjloader reads ''"), std::string::npos)
+            << e.what();
+    }
+    test::writeFile(dir + "/q.obj", "mtllib q.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nusemtl a\nf 1 2 3\n");
+    test::writeFile(dir + "/q.mtl", "newmtl a\nKd 0.5 0.5 0.5\nmap_Kd t.png\n");
+
+    // A file that is not a PNG: an error naming the material.
+    test::writeFile(dir + "/t.png", "not a png");
+    materials.clear();
+    TriangleMesh mesh3;
+    try {
+        loadObj(dir + "/q.obj", "w", -1, materials, mesh3, promoted, warnings);
+        ADD_FAILURE() << "a broken PNG must be an error";
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("w: '" + dir + "/q.obj': material 'a': map_Kd: " + dir + "/t.png"), std::string::npos)
+            << e.what();
+    }
 }

@@ -115,7 +115,7 @@ std::string checkObjText(std::string_view text, const std::string& where, const 
     std::string_view line;
     std::vector<std::string_view> t;
     long long counts[3] = {0, 0, 0};  // v, vt, vn defined so far
-    static const char* kElement[3] = {"vertex", "", "normal"};
+    static const char* kElement[3] = {"vertex", "texture coordinate", "normal"};
     static const char* kStatement[3] = {"v", "vt", "vn"};
     while (reader.next(line)) {
         const size_t n = reader.number();
@@ -141,7 +141,8 @@ std::string checkObjText(std::string_view text, const std::string& where, const 
             expectNumbers(t, 3, 3, "3 numbers (x y z)", src, n);
             ++counts[2];
         } else if (t[0] == "vt") {
-            ++counts[1];  // unused by wedge: its numbers are not checked
+            expectNumbers(t, 1, 3, "1 to 3 numbers (u [v] [w])", src, n);
+            ++counts[1];
         } else if (t[0] == "f") {
             if (t.size() < 4)
                 fail(src, n, "a face needs at least 3 corners, got " + std::to_string(t.size() - 1));
@@ -166,7 +167,7 @@ std::string checkObjText(std::string_view text, const std::string& where, const 
                         fail(src, n, "face corner " + quoted(corner) +
                                          (parts > 1 ? ": " + quoted(part[p]) : std::string()) +
                                          " is not a non-zero integer index");
-                    if (p != 1 && (index > counts[p] || -index > counts[p]))  // t: unused
+                    if (index > counts[p] || -index > counts[p])
                         fail(src, n, "face corner " + quoted(corner) + " refers to " + kElement[p] + " " +
                                           std::to_string(index) + ", but " + std::to_string(counts[p]) + " `" +
                                           kStatement[p] + (counts[p] == 1 ? "` line precedes it" : "` lines precede it"));
@@ -269,6 +270,8 @@ std::vector<MtlColours> checkMtlText(std::string_view text, const std::string& w
             if (t.size() == 3)
                 fail(src, n, "`" + std::string(key) + "` expects r g b (or one number for grey), got 2 values");
             (key == "Kd" ? current.greyKd : current.greyKe) = t.size() == 2;  // the last statement counts
+        } else if (key == "map_Kd" && t.size() > 1) {
+            current.mapKd = std::string(t.back());
         }
     }
     if (!current.name.empty()) materials.push_back(current);

@@ -14,11 +14,11 @@ namespace wedge::scene {
 
 /// Throws Error(where, "'<file>' line N: ...") at the first malformed line of OBJ text:
 /// - `v`: 3 to 7 finite numbers (x y z, an optional w, optional r g b);
-/// - `vn`: 3 finite numbers;
-/// - `f`: at least 3 corners `v`, `v/t`, `v//n` or `v/t/n` of non-zero integers, the vertex and
-///   normal naming one defined above the face (negative: counted back from the last one).
-/// What wedge does not use (texture coordinates, groups, smoothing, lines, points) is not
-/// checked beyond what tinyobjloader checks. Returns a warning (else "") naming the first line
+/// - `vn`: 3 finite numbers; `vt`: 1 to 3;
+/// - `f`: at least 3 corners `v`, `v/t`, `v//n` or `v/t/n` of non-zero integers, each naming an
+///   element defined above the face (negative: counted back from the last one).
+/// What wedge does not use (groups, smoothing, lines, points) is not checked beyond what
+/// tinyobjloader checks. Returns a warning (else "") naming the first line
 /// whose first word is not an OBJ statement (`v1 0 0`, `/v 0 0 0`): tinyobjloader skips such
 /// lines, so a mistyped `v` or `f` silently loses geometry.
 std::string checkObjText(std::string_view text, const std::string& where, const std::string& file);
@@ -28,10 +28,13 @@ std::string checkObjText(std::string_view text, const std::string& where, const 
 /// `searchDir` is empty) that no earlier statement read.
 std::vector<std::string> mtlFilesOf(std::string_view objText, const std::string& searchDir);
 
-/// A material of MTL text, in `newmtl` order, and which of its colours have one component.
+/// A material of MTL text, in `newmtl` order: which of its colours have one component, and the
+/// last word of its `map_Kd` statement, the file name (tinyobjloader's `-s 4 4 t.png` takes the
+/// file name as -s's third number and loses it; the caller compares).
 struct MtlColours {
     std::string name;
     bool greyKd = false, greyKe = false;
+    std::string mapKd;
 };
 
 /// Throws Error(where, "'<file>' line N: ...") at the first malformed colour that wedge renders, a Kd or

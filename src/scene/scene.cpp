@@ -101,7 +101,8 @@ Scene::Scene(SceneDesc desc) : m_desc(std::move(desc)) {
         if (m_geometry.size() <= id) m_geometry.resize(id + 1);
         m_geometry[id] = {mesh.materialIds.data(), mesh.shapeIds.data(), 0, object, false,
                           mesh.cornerNormals.size() == mesh.indices.size() ? mesh.cornerNormals.data() : nullptr,
-                          mesh.velocity * m_desc.camera.shutterLength()};
+                          mesh.velocity * m_desc.camera.shutterLength(),
+                          mesh.cornerUVs.size() == mesh.indices.size() ? mesh.cornerUVs.data() : nullptr};
         uint32_t shapes = 0;
         for (uint32_t sId : mesh.shapeIds) shapes = std::max(shapes, sId + 1);
         object += std::max(shapes, 1u);
@@ -162,7 +163,11 @@ void Scene::fillHit(const Vec3f& org, const Vec3f& dir, float t, float time, uns
     // Spheres: one surface each; meshes: one per shape.
     hit.object = g.object + (g.sphere ? primID : (g.shapeIds ? g.shapeIds[primID] : 0));
     const Material& m = m_desc.materials[hit.material];
-    if (m.texture.empty()) {
+    if (m.map && g.cornerUVs) {
+        const Vec2f* uv = g.cornerUVs + 3 * size_t(primID);
+        const float w0 = 1.f - u - v;
+        hit.albedo = m.albedo * m.map->lookup({w0 * uv[0].x + u * uv[1].x + v * uv[2].x, w0 * uv[0].y + u * uv[1].y + v * uv[2].y});
+    } else if (m.texture.empty()) {
         hit.albedo = m.albedo;
     } else {
         // The texture is attached to the object: look it up where the point was at shutter open.

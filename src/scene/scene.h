@@ -88,6 +88,7 @@ private:
         bool sphere = false;
         const Vec3f* cornerNormals = nullptr;  // 3 per primitive, or null: flat shading
         Vec3f displacement{0.f};  // meshes: over the whole shutter (spheres: their own, by primitive)
+        const Vec2f* cornerUVs = nullptr;  // 3 per primitive, or null
     };
 
     SceneDesc m_desc;

@@ -5,6 +5,26 @@
 
 namespace wedge::scene {
 
+Vec3f TextureMap::lookup(Vec2f uv) const {
+    const int w = texels.width(), h = texels.height();
+    float u = uv.x * scale.x + offset.x, v = uv.y * scale.y + offset.y;
+    if (clamp) {
+        u = std::clamp(u, 0.f, 1.f);
+        v = std::clamp(v, 0.f, 1.f);
+    }
+    // Texel centres at (i + 0.5) / w; v runs up the image, rows down it.
+    const float fx = u * float(w) - 0.5f, fy = (1.f - v) * float(h) - 0.5f;
+    const float x0f = std::floor(fx), y0f = std::floor(fy);
+    const float tx = fx - x0f, ty = fy - y0f;
+    auto index = [&](float i, int n) {
+        if (clamp) return std::clamp(int(i), 0, n - 1);
+        const float m = std::fmod(i, float(n));  // repeat, negative coordinates too
+        return std::clamp(int(m < 0 ? m + float(n) : m), 0, n - 1);
+    };
+    const int x0 = index(x0f, w), x1 = index(x0f + 1, w), y0 = index(y0f, h), y1 = index(y0f + 1, h);
+    return (texels(x0, y0) * (1 - tx) + texels(x1, y0) * tx) * (1 - ty) + (texels(x0, y1) * (1 - tx) + texels(x1, y1) * tx) * ty;
+}
+
 bool SceneDesc::hasMotion() const {
     for (auto& m : meshes)
         if (m.velocity != Vec3f(0.f)) return true;

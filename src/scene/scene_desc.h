@@ -4,12 +4,26 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
+#include "core/image.h"
 #include "core/math.h"
 
 namespace wedge::scene {
+
+/// An OBJ material's `map_Kd` image: linear RGB texels (a PNG decoded from sRGB), looked up at
+/// the mesh's texture coordinates with bilinear interpolation, repeating (or clamped with the
+/// MTL's `-clamp on`) after the MTL's `-s` scale and `-o` offset. The MTL format multiplies it by
+/// Kd. Texture coordinates (0, 0) are the image's bottom left corner.
+struct TextureMap {
+    std::string file;
+    Image3f texels;  // row 0 at the top (v = 1)
+    Vec2f scale{1.f, 1.f}, offset{0.f, 0.f};
+    bool clamp = false;
+    Vec3f lookup(Vec2f uv) const;
+};
 
 struct Material {
     std::string name;
@@ -18,6 +32,8 @@ struct Material {
     /// Procedural texture ("checker" or empty): scene/checker.h.
     std::string texture;
     float textureScale = 1.f;  // checker cells per world unit
+    /// An OBJ material's map_Kd (or null), times `albedo`, on meshes with texture coordinates.
+    std::shared_ptr<const TextureMap> map;
     bool isEmitter() const { return maxComponent(emission) > 0; }
 };
 
@@ -56,6 +72,9 @@ struct TriangleMesh {
     /// Shading normals, 3 per triangle (one per corner, unit length), or empty for flat shading
     /// (quads, boxes). OBJ meshes always have them: the file's `vn`, else smoothed face normals.
     std::vector<Vec3f> cornerNormals;
+    /// Texture coordinates, 3 per triangle (an OBJ's `vt`; (0, 0) at corners without one), or
+    /// empty.
+    std::vector<Vec2f> cornerUVs;
     Vec3f velocity{0.f};
     size_t triangleCount() const { return indices.size() / 3; }
 };

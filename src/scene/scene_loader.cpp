@@ -4,6 +4,8 @@
 #include <tiny_obj_loader.h>
 
 #include <algorithm>
+#include <cctype>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <exception>
@@ -14,6 +16,7 @@
 
 #include "core/error.h"
 #include "core/image.h"
+#include "io/image_io.h"
 #include "io/json_reader.h"
 #include "io/text_file.h"
 #include "scene/obj_check.h"
@@ -364,21 +367,60 @@ void parseObjChecked(const std::string& path, const std::string& where, tinyobj:
     if (!parsed) throw Error(where, "cannot read OBJ '" + path + "': " + reader.Error());
 }
 
+/// The material's map_Kd as a TextureMap (PNG files; the OBJ's directory is the search path), or
+/// null with the reason appended to `notRendered` ("'wood' (map_Kd 'wood.jpg': not PNG)").
+/// Maps shared by several materials are read once (`cache`).
+std::shared_ptr<const TextureMap> diffuseMap(const std::string& objPath, const std::string& where, const tinyobj::material_t& m,
+                                             std::map<std::string, std::shared_ptr<const TextureMap>>& cache,
+                                             std::vector<std::string>& notRendered) {
+    std::string name = m.diffuse_texname;
+    std::replace(name.begin(), name.end(), '\\', '/');  // exported on Windows
+    const fs::path file = fs::path(objPath).parent_path() / name;
+    std::string ext = file.extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+    if (ext != ".png") {
+        notRendered.push_back("'" + m.name + "' (map_Kd '" + name + "': wedge reads PNG textures)");
+        return nullptr;
+    }
+    if (!fs::is_regular_file(file)) {
+        notRendered.push_back("'" + m.name + "' (map_Kd '" + file.string() + "' does not exist)");
+        return nullptr;
+    }
+    const tinyobj::texture_option_t& o = m.diffuse_texopt;
+    const std::string key = file.string() + (o.clamp ? "|clamp" : "") + "|" + std::to_string(o.scale[0]) + "," +
+                            std::to_string(o.scale[1]) + "|" + std::to_string(o.origin_offset[0]) + "," + std::to_string(o.origin_offset[1]);
+    if (auto it = cache.find(key); it != cache.end()) return it->second;
+    auto map = std::make_shared<TextureMap>();
+    map->file = file.string();
+    try {
+        map->texels = io::readPng(map->file);  // sRGB decoded to linear
+    } catch (const Error& e) {
+        throw Error(where, "'" + objPath + "': material '" + m.name + "': map_Kd: " + e.what());
+    }
+    map->scale = {o.scale[0], o.scale[1]};
+    map->offset = {o.origin_offset[0], o.origin_offset[1]};
+    map->clamp = o.clamp;
+    if (!(std::isfinite(map->scale.x) && std::isfinite(map->scale.y) && std::isfinite(map->offset.x) && std::isfinite(map->offset.y)))
+        throw Error(where, "'" + objPath + "': material '" + m.name + "': map_Kd's -s and -o must be finite");
+    cache[key] = map;
+    return map;
+}
+
 /// Appends the MTL's materials to the scene's list (named "file.obj:name"); returns the scene
-/// index of each. What wedge does not render (specular terms, texture maps) is named in one
-/// warning per file.
+/// index of each. What wedge does not render (specular terms, texture maps other than a PNG
+/// map_Kd) is named in one warning per file.
 std::vector<uint32_t> appendMtlMaterials(const std::string& path, const std::string& where, const tinyobj::ObjReader& reader,
                                          const std::vector<MtlColours>& mtlColours, std::vector<Material>& materials,
                                          std::vector<std::string>& warnings) {
     std::vector<uint32_t> mtlToScene;
     const std::string prefix = fs::path(path).filename().string() + ":";
-    std::vector<std::string> specular, textured;
+    std::vector<std::string> specular, textured, maps;
+    std::map<std::string, std::shared_ptr<const TextureMap>> cache;
     const auto& mtlMaterials = reader.GetMaterials();
     for (size_t mi = 0; mi < mtlMaterials.size(); ++mi) {
         const tinyobj::material_t& m = mtlMaterials[mi];
         if (std::max({m.specular[0], m.specular[1], m.specular[2]}) > 0) specular.push_back(m.name);
-        if (!m.diffuse_texname.empty() || !m.bump_texname.empty() || !m.alpha_texname.empty() || !m.normal_texname.empty())
-            textured.push_back(m.name);
+        if (!m.bump_texname.empty() || !m.alpha_texname.empty() || !m.normal_texname.empty()) textured.push_back(m.name);
         Material mat;
         mat.name = prefix + m.name;
         mat.albedo = Vec3f(m.diffuse[0], m.diffuse[1], m.diffuse[2]);
@@ -387,6 +429,11 @@ std::vector<uint32_t> appendMtlMaterials(const std::string& path, const std::str
         if (mtlColours.size() == mtlMaterials.size() && mtlColours[mi].name == m.name) {
             if (mtlColours[mi].greyKd) mat.albedo = Vec3f(mat.albedo.x);
             if (mtlColours[mi].greyKe) mat.emission = Vec3f(mat.emission.x);
+            const std::string& file = mtlColours[mi].mapKd;
+            if (!file.empty() && file != m.diffuse_texname)
+                throw Error(where, "'" + path + "': material '" + m.name + "': map_Kd names '" + file +
+                                       "', but tinyobjloader reads '" + m.diffuse_texname +
+                                       "' (its -s, -o and -t options take three numbers each: write -s 4 4 1)");
         }
         // The MTL's colours obey the scene file's rules for "albedo" and "emission": a negative
         // or non-finite albedo would make negative or NaN light, and an albedo above 1 creates
@@ -400,15 +447,24 @@ std::vector<uint32_t> appendMtlMaterials(const std::string& path, const std::str
             bad("Kd", mat.albedo, "components must lie in [0, 1]");
         if (!isFinite(mat.emission) || std::min({mat.emission.x, mat.emission.y, mat.emission.z}) < 0)
             bad("Ke", mat.emission, "components must be finite and non-negative");
+        if (!m.diffuse_texname.empty()) mat.map = diffuseMap(path, where, m, cache, maps);
         mtlToScene.push_back(uint32_t(materials.size()));
         materials.push_back(mat);
     }
     // Valid input that wedge does not render: say so once per file, naming a few materials.
     std::string unused;
     if (!specular.empty()) unused += "the specular terms (Ks) of " + nameList(specular);
-    if (!textured.empty()) unused += std::string(unused.empty() ? "" : "; ") + "the texture maps of " + nameList(textured);
+    if (!textured.empty())
+        unused += std::string(unused.empty() ? "" : "; ") + "the bump, alpha and normal maps of " + nameList(textured);
+    if (!maps.empty()) {
+        std::string list;  // already quoted, with the reason
+        for (size_t i = 0; i < maps.size() && i < 3; ++i) list += (i ? ", " : "") + maps[i];
+        if (maps.size() > 3) list += " and " + std::to_string(maps.size() - 3) + " more";
+        unused += std::string(unused.empty() ? "" : "; ") + "the diffuse maps of " + list;
+    }
     if (!unused.empty())
-        warnings.push_back(where + ": '" + path + "': " + unused + " are not rendered (surfaces are Lambertian with the MTL's Kd)");
+        warnings.push_back(where + ": '" + path + "': " + unused +
+                           " are not rendered (surfaces are Lambertian with the MTL's Kd and PNG map_Kd)");
     return mtlToScene;
 }
 
@@ -441,8 +497,12 @@ void loadObj(const std::string& path, const std::string& where, int overrideMate
 
     size_t unlitFaces = 0;  // emissive faces that are not parallelograms: seen, not lights
     std::vector<std::string> unlitMaterials;
-    std::vector<uint32_t> idx;  // one face's vertices and normals, reused across faces
+    std::vector<uint32_t> idx;  // one face's vertices, normals and texture coordinates, reused
     std::vector<Vec3f> vn;      // the file's normals; zero: to be smoothed
+    std::vector<Vec2f> vt;      // the file's texture coordinates; (0, 0) where a corner has none
+    const size_t texcoordCount = attrib.texcoords.size() / 2;
+    const bool uvs = texcoordCount > 0;
+    if (uvs) mesh.cornerUVs.resize(mesh.indices.size());
     for (size_t shapeIndex = 0; shapeIndex < shapes.size(); ++shapeIndex) {
         const auto& shape = shapes[shapeIndex];
         size_t offset = 0;
@@ -466,6 +526,7 @@ void loadObj(const std::string& path, const std::string& where, int overrideMate
             }
             idx.assign(n, 0);
             vn.assign(n, Vec3f(0.f));
+            vt.assign(n, Vec2f{});
             for (int k = 0; k < n; ++k) {
                 int vi = shape.mesh.indices[offset + k].vertex_index;
                 if (vi < 0 || size_t(vi) >= vertexCount)
@@ -479,6 +540,8 @@ void loadObj(const std::string& path, const std::string& where, int overrideMate
                     if (!isFinite(nrm)) throw Error(where, "'" + path + "' has a non-finite normal (vn " + std::to_string(ni + 1) + ")");
                     if (length(nrm) > 0) vn[k] = normalize(nrm);  // a zero vn is smoothed like a missing one
                 }
+                const int ti = shape.mesh.indices[offset + k].texcoord_index;
+                if (ti >= 0 && size_t(ti) < texcoordCount) vt[k] = {attrib.texcoords[2 * ti], attrib.texcoords[2 * ti + 1]};
             }
             offset += n;
             if (n < 3) continue;
@@ -498,12 +561,22 @@ void loadObj(const std::string& path, const std::string& where, int overrideMate
             for (int k = 1; k + 1 < n; ++k) {  // fan triangulation (OBJ faces are convex)
                 mesh.indices.insert(mesh.indices.end(), {idx[0], idx[k], idx[k + 1]});
                 mesh.cornerNormals.insert(mesh.cornerNormals.end(), {vn[0], vn[k], vn[k + 1]});
+                if (uvs) mesh.cornerUVs.insert(mesh.cornerUVs.end(), {vt[0], vt[k], vt[k + 1]});
                 mesh.materialIds.push_back(matId);
                 mesh.shapeIds.push_back(uint32_t(shapeIndex));
             }
         }
     }
     if (mesh.indices.empty()) throw Error(where, "'" + path + "' contains no triangles");
+    if (!uvs) {
+        std::vector<std::string> mapped;
+        for (uint32_t id : mesh.materialIds)
+            if (materials[id].map && std::find(mapped.begin(), mapped.end(), materials[id].name) == mapped.end())
+                mapped.push_back(materials[id].name);
+        if (!mapped.empty())
+            warnings.push_back(where + ": '" + path + "': the map_Kd of " + nameList(mapped) +
+                               " is not rendered: the file has no texture coordinates (vt)");
+    }
     if (unlitFaces > 0) {
         warnings.push_back(where + ": '" + path + "': " + std::to_string(unlitFaces) + " emissive face(s) of " + nameList(unlitMaterials) +
                            " are not parallelograms: they are only seen and light nothing (only parallelogram "
