@@ -204,6 +204,19 @@ std::string mtlError(const std::string& mtl) {
     return errorOf([&] { checkMtlText(mtl, "s.json: objects[0].file", "m.mtl"); });
 }
 
+/// What loadObj makes of an OBJ file on its own (its MTL's materials).
+struct LoadedObj {
+    std::vector<Material> materials;
+    TriangleMesh mesh;
+    std::vector<ParallelogramLight> promoted;
+    std::vector<std::string> warnings;
+};
+LoadedObj loadObjFile(const std::string& path, const std::string& where = "w") {
+    LoadedObj o;
+    loadObj(path, where, -1, o.materials, o.mesh, o.promoted, o.warnings);
+    return o;
+}
+
 }  // namespace
 
 TEST(ObjCheck, AcceptsWhatTheObjFormatAllows) {
@@ -299,11 +312,7 @@ TEST(ObjCheck, AGreyMtlColourLoadsAsGrey) {
     std::string dir = test::tempDir();
     test::writeFile(dir + "/q.obj", "mtllib q.mtl\nv -1 0 -1\nv 1 0 -1\nv 1 0 1\nv -1 0 1\nusemtl g\nf 1 4 3\nusemtl c\nf 1 3 2\n");
     test::writeFile(dir + "/q.mtl", "newmtl g\nKd 0.5\nKe 2\nnewmtl c\nKd 0.1 0.2 0.3\n");
-    std::vector<Material> materials;
-    TriangleMesh mesh;
-    std::vector<ParallelogramLight> promoted;
-    std::vector<std::string> warnings;
-    loadObj(dir + "/q.obj", "s.json: objects[0].file", -1, materials, mesh, promoted, warnings);
+    const std::vector<Material> materials = loadObjFile(dir + "/q.obj").materials;
     ASSERT_EQ(materials.size(), 2u);
     EXPECT_EQ(materials[0].albedo, Vec3f(0.5f));
     EXPECT_EQ(materials[0].emission, Vec3f(2.f));
@@ -408,63 +417,38 @@ TEST(SceneFile, DiffuseMapsWedgeCannotReadAreNamed) {
     std::string dir = test::tempDir();
     test::writeFile(dir + "/q.obj", "mtllib q.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nusemtl a\nf 1 2 3\nusemtl b\nf 1 3 2\n");
     test::writeFile(dir + "/q.mtl", "newmtl a\nKd 0.5 0.5 0.5\nmap_Kd wood.jpg\nnewmtl b\nKd 0.5 0.5 0.5\nmap_Kd gone.png\n");
-    std::vector<Material> materials;
-    TriangleMesh mesh;
-    std::vector<ParallelogramLight> promoted;
-    std::vector<std::string> warnings;
-    loadObj(dir + "/q.obj", "w", -1, materials, mesh, promoted, warnings);
-    ASSERT_EQ(warnings.size(), 1u);
-    EXPECT_NE(warnings[0].find("the diffuse maps of 'a' (map_Kd 'wood.jpg': wedge reads PNG textures), 'b' (map_Kd '" + dir +
-                               "/gone.png' does not exist) are not rendered"),
+    LoadedObj o = loadObjFile(dir + "/q.obj");
+    ASSERT_EQ(o.warnings.size(), 1u);
+    EXPECT_NE(o.warnings[0].find("the diffuse maps of 'a' (map_Kd 'wood.jpg': wedge reads PNG textures), 'b' (map_Kd '" + dir +
+                                 "/gone.png' does not exist) are not rendered"),
               std::string::npos)
-        << warnings[0];
-    EXPECT_FALSE(materials[0].map);
+        << o.warnings[0];
+    EXPECT_FALSE(o.materials[0].map);
 
     // A PNG map on a file without texture coordinates.
     Image3f img(1, 1, Vec3f(0.5f));
     io::writePng(dir + "/t.png", img);
     test::writeFile(dir + "/q.mtl", "newmtl a\nKd 0.5 0.5 0.5\nmap_Kd t.png\nnewmtl b\nKd 0.5 0.5 0.5\n");
-    materials.clear();
-    warnings.clear();
-    TriangleMesh mesh2;
-    loadObj(dir + "/q.obj", "w", -1, materials, mesh2, promoted, warnings);
-    ASSERT_EQ(warnings.size(), 1u);
-    EXPECT_NE(warnings[0].find("the map_Kd of 'q.obj:a' is not rendered: the file has no texture coordinates (vt)"), std::string::npos)
-        << warnings[0];
+    o = loadObjFile(dir + "/q.obj");
+    ASSERT_EQ(o.warnings.size(), 1u);
+    EXPECT_NE(o.warnings[0].find("the map_Kd of 'q.obj:a' is not rendered: the file has no texture coordinates (vt)"), std::string::npos)
+        << o.warnings[0];
 
     // Options: -s with three numbers scales (u, v); with two, tinyobjloader takes the file name
     // for the third and loses it, which is an error rather than an untextured material.
-    test::writeFile(dir + "/q.obj", "mtllib q.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nvt 0 0\nusemtl a\nf 1/1 2/1 3/1\n");
-    test::writeFile(dir + "/q.mtl", "newmtl a\nKd 0.5 0.5 0.5\nmap_Kd -s 4 2 1 -o 0.5 0 0 t.png\n");
-    materials.clear();
-    TriangleMesh mesh4;
-    loadObj(dir + "/q.obj", "w", -1, materials, mesh4, promoted, warnings);
-    ASSERT_TRUE(materials[0].map);
-    EXPECT_EQ(materials[0].map->scale.x, 4.f);
-    EXPECT_EQ(materials[0].map->scale.y, 2.f);
-    EXPECT_EQ(materials[0].map->offset.x, 0.5f);
-    test::writeFile(dir + "/q.mtl", "newmtl a\nKd 0.5 0.5 0.5\nmap_Kd -s 4 4 t.png\n");
-    materials.clear();
-    TriangleMesh mesh5;
-    try {
-        loadObj(dir + "/q.obj", "w", -1, materials, mesh5, promoted, warnings);
-        ADD_FAILURE() << "map_Kd -s 4 4 t.png must be an error";
-    } catch (const Error& e) {
-        EXPECT_NE(std::string(e.what()).find("material 'a': map_Kd names 't.png', but tinyobjloader reads ''"), std::string::npos)
-            << e.what();
-    }
-    test::writeFile(dir + "/q.obj", "mtllib q.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nusemtl a\nf 1 2 3\n");
-    test::writeFile(dir + "/q.mtl", "newmtl a\nKd 0.5 0.5 0.5\nmap_Kd t.png\n");
+    test::writeFile(dir + "/uv.obj", "mtllib uv.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nvt 0 0\nusemtl a\nf 1/1 2/1 3/1\n");
+    test::writeFile(dir + "/uv.mtl", "newmtl a\nKd 0.5 0.5 0.5\nmap_Kd -s 4 2 1 -o 0.5 0 0 t.png\n");
+    o = loadObjFile(dir + "/uv.obj");
+    ASSERT_TRUE(o.materials[0].map);
+    EXPECT_EQ(o.materials[0].map->scale.x, 4.f);
+    EXPECT_EQ(o.materials[0].map->scale.y, 2.f);
+    EXPECT_EQ(o.materials[0].map->offset.x, 0.5f);
+    test::writeFile(dir + "/uv.mtl", "newmtl a\nKd 0.5 0.5 0.5\nmap_Kd -s 4 4 t.png\n");
+    EXPECT_NE(errorOf([&] { loadObjFile(dir + "/uv.obj"); }).find("material 'a': map_Kd names 't.png', but tinyobjloader reads ''"),
+              std::string::npos);
 
     // A file that is not a PNG: an error naming the material.
     test::writeFile(dir + "/t.png", "not a png");
-    materials.clear();
-    TriangleMesh mesh3;
-    try {
-        loadObj(dir + "/q.obj", "w", -1, materials, mesh3, promoted, warnings);
-        ADD_FAILURE() << "a broken PNG must be an error";
-    } catch (const Error& e) {
-        EXPECT_NE(std::string(e.what()).find("w: '" + dir + "/q.obj': material 'a': map_Kd: " + dir + "/t.png"), std::string::npos)
-            << e.what();
-    }
+    EXPECT_NE(errorOf([&] { loadObjFile(dir + "/q.obj"); }).find("w: '" + dir + "/q.obj': material 'a': map_Kd: " + dir + "/t.png"),
+              std::string::npos);
 }
