@@ -17,6 +17,20 @@ namespace wedge::app {
 
 namespace {
 
+/// The scene with its warnings printed, and one more: the rasterizer textures with the
+/// procedural checker only, so a material's map_Kd shows as its Kd.
+scene::SceneDesc loadRasterScene(const std::string& name) {
+    scene::SceneDesc desc = scene::loadScene(name);
+    std::vector<std::string> mapped;
+    for (const auto& m : desc.materials)
+        if (m.map) mapped.push_back(m.name);
+    if (!mapped.empty())
+        desc.warnings.push_back(desc.file + ": wedge raster renders the map_Kd of " + std::to_string(mapped.size()) +
+                                " material(s) ('" + mapped[0] + "'" + (mapped.size() > 1 ? ", ..." : "") + ") as its Kd alone");
+    printWarnings(desc);
+    return desc;
+}
+
 struct RasterArgs {
     std::string scene;
     std::string shading = "aas";
@@ -79,8 +93,7 @@ void runSweep(const RasterArgs& a) {
     if (ec) throw Error("--out " + a.outDir, "cannot create the directory: " + ec.message());
 
     ThreadLimit limit(a.threads);
-    scene::SceneDesc desc = scene::loadScene(a.scene);
-    printWarnings(desc);
+    scene::SceneDesc desc = loadRasterScene(a.scene);
     applyResolution(desc, a.resolution);
     raster::SweepResult sweep = raster::sweepCache(desc, options(a, desc), a.sweep);
 
@@ -116,8 +129,7 @@ void runRaster(const RasterArgs& a) {
     if (!a.stats.empty()) io::checkOutputPath(a.stats, {".json"});
 
     ThreadLimit limit(a.threads);
-    scene::SceneDesc desc = scene::loadScene(a.scene);
-    printWarnings(desc);
+    scene::SceneDesc desc = loadRasterScene(a.scene);
     applyResolution(desc, a.resolution);
     raster::RasterResult r = raster::renderRaster(desc, options(a, desc));
     if (r.stats.splitBudgetReached)
