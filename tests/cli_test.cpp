@@ -207,7 +207,7 @@ TEST(Cli, ObjWithBadFaceIndex) {
     std::string dir = tempDir();
     writeFile(dir + "/broken.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 7\n");
     expectRejected(scene(R"({"type": "mesh", "file": ")" + dir + R"(/broken.obj", "material": "white"})"),
-                   "objects[0].file: '" + dir + "/broken.obj' line 4: face corner '7' refers to vertex 7, but 3 `v` lines precede it");
+                   "objects[0].file: '" + dir + "/broken.obj' line 4: face corner '7' refers to vertex 7, but the file has 3 `v` lines");
 }
 
 TEST(Cli, ObjWhoseMtlIsMissingSaysSo) {
@@ -233,7 +233,7 @@ TEST(Cli, ObjWithBadNormalIndex) {
     std::string dir = tempDir();
     writeFile(dir + "/badvn.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nf 1//1 2//1 3//4\n");
     expectRejected(scene(R"({"type": "mesh", "file": ")" + dir + R"(/badvn.obj", "material": "white"})"),
-                   "badvn.obj' line 5: face corner '3//4' refers to normal 4, but 1 `vn` line precedes it");
+                   "badvn.obj' line 5: face corner '3//4' refers to normal 4, but the file has 1 `vn` line");
 }
 
 TEST(Cli, NoLight) {

@@ -258,11 +258,15 @@ TEST(ObjCheck, NamesTheLineOfEveryMalformedFace) {
     EXPECT_NE(objError(tri + "f 1 2 3 # c\n").find("face corner '#' is not a non-zero integer index"), std::string::npos)
         << "tinyobjloader rejects a comment after a face";
     EXPECT_NE(objError(tri + "f 1 2\n").find("line 4: a face needs at least 3 corners, got 2"), std::string::npos);
-    // An index names an element defined above the face, as the format says.
-    EXPECT_EQ(objError(tri + "f 1 2 4\nv 0 0 1\n"),
-              "s.json: objects[0].file: 'm.obj' line 4: face corner '4' refers to vertex 4, but 3 `v` lines precede it");
-    EXPECT_NE(objError(tri + "f 1 2 -4\n").find("refers to vertex -4, but 3 `v` lines precede it"), std::string::npos);
-    EXPECT_NE(objError(tri + "vn 0 0 1\nf 1//1 2//1 3//2\n").find("line 5: face corner '3//2' refers to normal 2, but 1 `vn` line precedes it"),
+    // An index names an element of the file; a negative one counts back from the last one
+    // defined above the face. (tinyobjloader resolves positive indices after reading the file,
+    // so a face may name a vertex defined below it.)
+    EXPECT_EQ(objError(tri + "f 1 2 4\nv 0 0 1\n"), "");
+    EXPECT_EQ(objError(tri + "f 1 2 7\nf 1 2 5\nv 0 0 1\n"),
+              "s.json: objects[0].file: 'm.obj' line 4: face corner '7' refers to vertex 7, but the file has 4 `v` lines");
+    EXPECT_NE(objError(tri + "f 1 2 -4\nv 0 0 1\n").find("line 4: face corner '-4' refers to vertex -4, but 3 `v` lines precede it"),
+              std::string::npos);
+    EXPECT_NE(objError(tri + "vn 0 0 1\nf 1//1 2//1 3//2\n").find("line 5: face corner '3//2' refers to normal 2, but the file has 1 `vn` line"),
               std::string::npos);
 }
 

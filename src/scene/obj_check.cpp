@@ -115,6 +115,11 @@ std::string checkObjText(std::string_view text, const std::string& where, const 
     std::string_view line;
     std::vector<std::string_view> t;
     long long counts[3] = {0, 0, 0};  // v, vt, vn defined so far
+    // The largest positive index of each kind, where it is: checked against the file's totals at
+    // the end, since tinyobjloader resolves them after reading (a face may name a later vertex).
+    long long largest[3] = {0, 0, 0};
+    size_t largestLine[3] = {0, 0, 0};
+    std::string largestCorner[3];
     static const char* kElement[3] = {"vertex", "texture coordinate", "normal"};
     static const char* kStatement[3] = {"v", "vt", "vn"};
     while (reader.next(line)) {
@@ -167,14 +172,24 @@ std::string checkObjText(std::string_view text, const std::string& where, const 
                         fail(src, n, "face corner " + quoted(corner) +
                                          (parts > 1 ? ": " + quoted(part[p]) : std::string()) +
                                          " is not a non-zero integer index");
-                    if (index > counts[p] || -index > counts[p])
+                    if (-index > counts[p])  // negative: counted back from the last one so far
                         fail(src, n, "face corner " + quoted(corner) + " refers to " + kElement[p] + " " +
                                           std::to_string(index) + ", but " + std::to_string(counts[p]) + " `" +
                                           kStatement[p] + (counts[p] == 1 ? "` line precedes it" : "` lines precede it"));
+                    if (index > largest[p]) {
+                        largest[p] = index;
+                        largestLine[p] = n;
+                        largestCorner[p] = quoted(corner);
+                    }
                 }
             }
         }
     }
+    for (int p = 0; p < 3; ++p)
+        if (largest[p] > counts[p])
+            fail(src, largestLine[p], "face corner " + largestCorner[p] + " refers to " + kElement[p] + " " +
+                                          std::to_string(largest[p]) + ", but the file has " + std::to_string(counts[p]) +
+                                          " `" + kStatement[p] + (counts[p] == 1 ? "` line" : "` lines"));
     if (unknown == 0) return "";
     // tinyobjloader skips what it does not know; a mistyped `v` or `f` would lose geometry.
     return "'" + file + "' line " + std::to_string(firstUnknownLine) + ": " + firstUnknown +

@@ -16,7 +16,7 @@ namespace wedge::scene {
 /// - `v`: 3 to 7 finite numbers (x y z, an optional w, optional r g b);
 /// - `vn`: 3 finite numbers; `vt`: 1 to 3;
 /// - `f`: at least 3 corners `v`, `v/t`, `v//n` or `v/t/n` of non-zero integers, each naming an
-///   element defined above the face (negative: counted back from the last one).
+///   element of the file (negative: counted back from the last one defined above the face).
 /// What wedge does not use (groups, smoothing, lines, points) is not checked beyond what
 /// tinyobjloader checks. Returns a warning (else "") naming the first line
 /// whose first word is not an OBJ statement (`v1 0 0`, `/v 0 0 0`): tinyobjloader skips such
