@@ -448,8 +448,15 @@ TEST(SceneFile, DiffuseMapsWedgeCannotReadAreNamed) {
     EXPECT_EQ(o.materials[0].map->scale.y, 2.f);
     EXPECT_EQ(o.materials[0].map->offset.x, 0.5f);
     test::writeFile(dir + "/uv.mtl", "newmtl a\nKd 0.5 0.5 0.5\nmap_Kd -s 4 4 t.png\n");
-    EXPECT_NE(errorOf([&] { loadObjFile(dir + "/uv.obj"); }).find("material 'a': map_Kd names 't.png', but tinyobjloader reads ''"),
+    EXPECT_NE(errorOf([&] { loadObjFile(dir + "/uv.obj"); }).find("material 'a': tinyobjloader reads 'map_Kd -s 4 4 t.png' as the file ''"),
               std::string::npos);
+    // A file name with a space is the rest of the line, for tinyobjloader too.
+    io::writePng(dir + "/my t.png", img);
+    test::writeFile(dir + "/uv.mtl", "newmtl a\nKd 0.5 0.5 0.5\nmap_Kd -clamp on my t.png \n");
+    o = loadObjFile(dir + "/uv.obj");
+    ASSERT_TRUE(o.materials[0].map);
+    EXPECT_EQ(o.materials[0].map->file, dir + "/my t.png");
+    EXPECT_TRUE(o.materials[0].map->clamp);
 
     // A file that is not a PNG: an error naming the material.
     test::writeFile(dir + "/t.png", "not a png");

@@ -286,7 +286,10 @@ std::vector<MtlColours> checkMtlText(std::string_view text, const std::string& w
                 fail(src, n, "`" + std::string(key) + "` expects r g b (or one number for grey), got 2 values");
             (key == "Kd" ? current.greyKd : current.greyKe) = t.size() == 2;  // the last statement counts
         } else if (key == "map_Kd" && t.size() > 1) {
-            current.mapKd = std::string(t.back());
+            std::string_view args = rest.substr(6);
+            while (!args.empty() && isBlank(args.front())) args.remove_prefix(1);
+            while (!args.empty() && isBlank(args.back())) args.remove_suffix(1);
+            current.mapKd = std::string(args);
         }
     }
     if (!current.name.empty()) materials.push_back(current);

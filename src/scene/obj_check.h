@@ -28,9 +28,10 @@ std::string checkObjText(std::string_view text, const std::string& where, const 
 /// `searchDir` is empty) that no earlier statement read.
 std::vector<std::string> mtlFilesOf(std::string_view objText, const std::string& searchDir);
 
-/// A material of MTL text, in `newmtl` order: which of its colours have one component, and the
-/// last word of its `map_Kd` statement, the file name (tinyobjloader's `-s 4 4 t.png` takes the
-/// file name as -s's third number and loses it; the caller compares).
+/// A material of MTL text, in `newmtl` order: which of its colours have one component, and its
+/// `map_Kd` statement after the keyword, options and file name (the file name ends it; the caller
+/// checks that tinyobjloader's ends it too: its `-s 4 4 t.png` takes the file name for -s's third
+/// number and loses it).
 struct MtlColours {
     std::string name;
     bool greyKd = false, greyKe = false;

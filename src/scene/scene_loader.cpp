@@ -429,10 +429,13 @@ std::vector<uint32_t> appendMtlMaterials(const std::string& path, const std::str
         if (mtlColours.size() == mtlMaterials.size() && mtlColours[mi].name == m.name) {
             if (mtlColours[mi].greyKd) mat.albedo = Vec3f(mat.albedo.x);
             if (mtlColours[mi].greyKe) mat.emission = Vec3f(mat.emission.x);
-            const std::string& file = mtlColours[mi].mapKd;
-            if (!file.empty() && file != m.diffuse_texname)
-                throw Error(where, "'" + path + "': material '" + m.name + "': map_Kd names '" + file +
-                                       "', but tinyobjloader reads '" + m.diffuse_texname +
+            const std::string& statement = mtlColours[mi].mapKd;  // options, then the file name
+            const std::string& file = m.diffuse_texname;
+            const bool endsWithFile = !file.empty() && statement.size() >= file.size() &&
+                                      statement.compare(statement.size() - file.size(), file.size(), file) == 0;
+            if (!statement.empty() && !endsWithFile)
+                throw Error(where, "'" + path + "': material '" + m.name + "': tinyobjloader reads 'map_Kd " + statement +
+                                       "' as the file '" + file +
                                        "' (its -s, -o and -t options take three numbers each: write -s 4 4 1)");
         }
         // The MTL's colours obey the scene file's rules for "albedo" and "emission": a negative
