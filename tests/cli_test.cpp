@@ -249,7 +249,7 @@ TEST(Cli, MtlTermsThatAreNotRenderedAreNamed) {
     writeFile(dir + "/quad.obj",
               "mtllib quad.mtl\nv -1 0 -1\nv 1 0 -1\nv 1 0 1\nv -1 0 1\nusemtl shiny\nf 1 4 3\nusemtl matte\nf 1 3 2\n");
     writeFile(dir + "/quad.mtl",
-              "newmtl shiny\nKd 0.5 0.5 0.5\nKs 0.7 0.7 0.7\nmap_Kd wood.png\nnewmtl matte\nKd 0.4 0.4 0.4\n");
+              "newmtl shiny\nKd 0.5 0.5 0.5\nKs 0.7 0.7 0.7\nmap_Kd wood.png\nd 0.5\nnewmtl matte\nKd 0.4 0.4 0.4\nd 1\n");
     writeFile(dir + "/s.json", scene(R"({"type": "mesh", "file": "quad.obj"})"));
     std::string err;
     ASSERT_EQ(runWedge("render " + dir + "/s.json --quiet -o " + dir + "/x.png", nullptr, &err), 0) << err;
@@ -257,6 +257,7 @@ TEST(Cli, MtlTermsThatAreNotRenderedAreNamed) {
     EXPECT_NE(err.find("warning: " + dir + "/s.json: objects[0].file: '" + dir + "/quad.obj'"), std::string::npos) << err;
     EXPECT_NE(err.find("specular terms (Ks) of 'shiny'"), std::string::npos) << err;
     EXPECT_NE(err.find("the diffuse maps of 'shiny' (map_Kd '" + dir + "/wood.png' does not exist)"), std::string::npos) << err;
+    EXPECT_NE(err.find("the transparency (d < 1) of 'shiny'"), std::string::npos) << err;
     EXPECT_EQ(err.find("matte"), std::string::npos) << err;
 
     writeFile(dir + "/quad.mtl", "newmtl shiny\nKd 0.5 0.5 0.5\nnewmtl matte\nKd 0.4 0.4 0.4\n");

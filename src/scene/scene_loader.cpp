@@ -407,20 +407,21 @@ std::shared_ptr<const TextureMap> diffuseMap(const std::string& objPath, const s
 }
 
 /// Appends the MTL's materials to the scene's list (named "file.obj:name"); returns the scene
-/// index of each. What wedge does not render (specular terms, texture maps other than a PNG
-/// map_Kd) is named in one warning per file.
+/// index of each. What wedge does not render (specular terms, transparency, texture maps other
+/// than a PNG map_Kd) is named in one warning per file.
 std::vector<uint32_t> appendMtlMaterials(const std::string& path, const std::string& where, const tinyobj::ObjReader& reader,
                                          const std::vector<MtlColours>& mtlColours, std::vector<Material>& materials,
                                          std::vector<std::string>& warnings) {
     std::vector<uint32_t> mtlToScene;
     const std::string prefix = fs::path(path).filename().string() + ":";
-    std::vector<std::string> specular, textured, maps;
+    std::vector<std::string> specular, textured, maps, transparent;
     std::map<std::string, std::shared_ptr<const TextureMap>> cache;
     const auto& mtlMaterials = reader.GetMaterials();
     for (size_t mi = 0; mi < mtlMaterials.size(); ++mi) {
         const tinyobj::material_t& m = mtlMaterials[mi];
         if (std::max({m.specular[0], m.specular[1], m.specular[2]}) > 0) specular.push_back(m.name);
         if (!m.bump_texname.empty() || !m.alpha_texname.empty() || !m.normal_texname.empty()) textured.push_back(m.name);
+        if (m.dissolve < 1.f) transparent.push_back(m.name);  // d < 1, or Tr > 0
         Material mat;
         mat.name = prefix + m.name;
         mat.albedo = Vec3f(m.diffuse[0], m.diffuse[1], m.diffuse[2]);
@@ -459,6 +460,8 @@ std::vector<uint32_t> appendMtlMaterials(const std::string& path, const std::str
     if (!specular.empty()) unused += "the specular terms (Ks) of " + nameList(specular);
     if (!textured.empty())
         unused += std::string(unused.empty() ? "" : "; ") + "the bump, alpha and normal maps of " + nameList(textured);
+    if (!transparent.empty())
+        unused += std::string(unused.empty() ? "" : "; ") + "the transparency (d < 1) of " + nameList(transparent);
     if (!maps.empty()) {
         std::string list;  // already quoted, with the reason
         for (size_t i = 0; i < maps.size() && i < 3; ++i) list += (i ? ", " : "") + maps[i];
