@@ -415,6 +415,10 @@ TEST(SceneFile, ObjDiffuseMapsTextureTheAlbedo) {
     EXPECT_TRUE(near(map.lookup({0.f, 0.75f}), (map.texels(0, 0) + map.texels(1, 0)) * 0.5f));
     EXPECT_TRUE(near(map.lookup({1.25f, 0.75f}), map.texels(0, 0))) << "repeats";
     EXPECT_TRUE(near(map.lookup({-0.75f, -0.25f}), map.texels(0, 0))) << "repeats below zero";
+    for (float big : {3e38f, -3e38f, 1e30f}) {
+        const Vec3f c = map.lookup({big, big * 4});  // overflows to infinity: a texel all the same
+        EXPECT_TRUE(isFinite(c) && c.x >= 0 && c.x <= 1) << big;
+    }
 }
 
 TEST(SceneFile, DiffuseMapsWedgeCannotReadAreNamed) {

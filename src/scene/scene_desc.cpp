@@ -8,6 +8,8 @@ namespace wedge::scene {
 Vec3f TextureMap::lookup(Vec2f uv) const {
     const int w = texels.width(), h = texels.height();
     float u = uv.x * scale.x + offset.x, v = uv.y * scale.y + offset.y;
+    if (!std::isfinite(u)) u = 0.f;  // vt and -s are finite, but their product may overflow
+    if (!std::isfinite(v)) v = 0.f;
     if (clamp) {
         u = std::clamp(u, 0.f, 1.f);
         v = std::clamp(v, 0.f, 1.f);
