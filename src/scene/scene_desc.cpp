@@ -14,14 +14,15 @@ Vec3f TextureMap::lookup(Vec2f uv) const {
         u = std::clamp(u, 0.f, 1.f);
         v = std::clamp(v, 0.f, 1.f);
     }
-    // Texel centres at (i + 0.5) / w; v runs up the image, rows down it.
-    const float fx = u * float(w) - 0.5f, fy = (1.f - v) * float(h) - 0.5f;
-    const float x0f = std::floor(fx), y0f = std::floor(fy);
-    const float tx = fx - x0f, ty = fy - y0f;
-    auto index = [&](float i, int n) {
-        if (clamp) return std::clamp(int(i), 0, n - 1);
-        const float m = std::fmod(i, float(n));  // repeat, negative coordinates too
-        return std::clamp(int(m < 0 ? m + float(n) : m), 0, n - 1);
+    // Texel centres at (i + 0.5) / w; v runs up the image, rows down it. In double: u x w
+    // overflows float for u near its largest values.
+    const double fx = double(u) * w - 0.5, fy = (1.0 - double(v)) * h - 0.5;
+    const double x0f = std::floor(fx), y0f = std::floor(fy);
+    const float tx = float(fx - x0f), ty = float(fy - y0f);
+    auto index = [&](double i, int n) {
+        if (clamp) return int(std::clamp(i, 0.0, double(n - 1)));
+        const double m = std::fmod(i, double(n));  // repeat, negative coordinates too
+        return std::clamp(int(m < 0 ? m + n : m), 0, n - 1);
     };
     const int x0 = index(x0f, w), x1 = index(x0f + 1, w), y0 = index(y0f, h), y1 = index(y0f + 1, h);
     return (texels(x0, y0) * (1 - tx) + texels(x1, y0) * tx) * (1 - ty) + (texels(x0, y1) * (1 - tx) + texels(x1, y1) * tx) * ty;
