@@ -368,7 +368,7 @@ void parseObjChecked(const std::string& path, const std::string& where, tinyobj:
 }
 
 /// The material's map_Kd as a TextureMap (PNG files; the OBJ's directory is the search path), or
-/// null with the reason appended to `notRendered` ("'wood' (map_Kd 'wood.jpg': not PNG)").
+/// null with the reason appended to `notRendered` ("'wood' (map_Kd 'wood.jpg': wedge reads PNG textures)").
 /// Maps shared by several materials are read once (`cache`).
 std::shared_ptr<const TextureMap> diffuseMap(const std::string& objPath, const std::string& where, const tinyobj::material_t& m,
                                              std::map<std::string, std::shared_ptr<const TextureMap>>& cache,
