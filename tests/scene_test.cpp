@@ -370,10 +370,35 @@ TEST(SceneFile, EmittersThatLightNothingAreNamed) {
     test::writeFile(dir + "/lamp.obj", "mtllib lamp.mtl\nv 0 2 0\nv 1 2 0\nv 0 2 1\nv 1 2 1\nusemtl lamp\nf 1 2 3\nf 1 3 4 2\n");
     test::writeFile(dir + "/lamp.mtl", "newmtl lamp\nKd 0 0 0\nKe 9 9 9\n");
     auto [obj, objLights] = warningsOf(R"({"type": "mesh", "file": "lamp.obj"})", dir);
-    EXPECT_NE(obj.find("s.json: objects[0].file: '" + dir + "/lamp.obj': 1 emissive face(s) of 'lamp.obj:lamp' are not parallelograms"),
+    EXPECT_NE(obj.find("s.json: objects[0].file: '" + dir + "/lamp.obj': 1 emissive triangle(s) of 'lamp.obj:lamp' form no parallelogram"),
               std::string::npos)
         << obj;
     EXPECT_EQ(objLights, 2u) << "the parallelogram face is a light, the triangle is not";
+}
+
+TEST(SceneFile, TwoEmissiveTrianglesThatMakeAParallelogramAreALight) {
+    // A triangulating exporter splits a rectangular light along one diagonal or the other; the
+    // two triangles become one parallelogram light again, facing as they do.
+    std::string dir = test::tempDir();
+    test::writeFile(dir + "/lamp.mtl", "newmtl lamp\nKd 0 0 0\nKe 9 9 9\n");
+    const std::string corners = "mtllib lamp.mtl\nv 0 2 0\nv 0 2 1\nv 2 2 1\nv 2 2 0\nusemtl lamp\n";  // wound to face +y
+    for (const char* faces : {"f 1 2 3\nf 1 3 4\n", "f 1 2 4\nf 2 3 4\n", "f 3 4 1\nf 2 3 1\n"}) {
+        test::writeFile(dir + "/lamp.obj", corners + faces);
+        LoadedObj o = loadObjFile(dir + "/lamp.obj");
+        ASSERT_EQ(o.promoted.size(), 1u) << faces;
+        EXPECT_TRUE(o.warnings.empty()) << o.warnings[0];
+        const ParallelogramLight& l = o.promoted[0];
+        EXPECT_NEAR(l.area(), 2.f, 1e-6f) << faces;
+        EXPECT_NEAR(l.normal().y, 1.f, 1e-6f) << faces;  // as each triangle faces
+        EXPECT_EQ(l.radiance, Vec3f(9.f));
+    }
+    // Not a parallelogram (a kite), or two triangles with one corner in common: seen only.
+    for (const char* faces : {"v 1 2 -3\nf 1 2 3\nf 1 3 5\n", "f 1 2 3\nf 3 4 1\nf 1 2 4\n"}) {
+        test::writeFile(dir + "/lamp.obj", corners + faces);
+        LoadedObj o = loadObjFile(dir + "/lamp.obj");
+        ASSERT_EQ(o.warnings.size(), 1u) << faces;
+        EXPECT_NE(o.warnings[0].find("form no parallelogram"), std::string::npos) << o.warnings[0];
+    }
 }
 
 TEST(SceneFile, ObjDiffuseMapsTextureTheAlbedo) {

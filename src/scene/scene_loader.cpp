@@ -501,8 +501,11 @@ void loadObj(const std::string& path, const std::string& where, int overrideMate
     for (auto& v : mesh.positions)
         if (!isFinite(v)) throw Error(where, "'" + path + "' has a non-finite vertex coordinate");
 
-    size_t unlitFaces = 0;  // emissive faces that are not parallelograms: seen, not lights
-    std::vector<std::string> unlitMaterials;
+    struct EmissiveTriangle {
+        uint32_t v[3];
+        uint32_t material;
+    };
+    std::vector<EmissiveTriangle> emissiveTriangles;  // to be paired into parallelograms below
     std::vector<uint32_t> idx;  // one face's vertices, normals and texture coordinates, reused
     std::vector<Vec3f> vn;      // the file's normals; zero: to be smoothed
     std::vector<Vec2f> vt;      // the file's texture coordinates; (0, 0) where a corner has none
@@ -559,9 +562,7 @@ void loadObj(const std::string& path, const std::string& where, int overrideMate
                     light.radiance = materials[matId].emission;
                     promoted.push_back(light);
                 } else {
-                    ++unlitFaces;
-                    if (std::find(unlitMaterials.begin(), unlitMaterials.end(), materials[matId].name) == unlitMaterials.end())
-                        unlitMaterials.push_back(materials[matId].name);
+                    for (int k = 1; k + 1 < n; ++k) emissiveTriangles.push_back({{idx[0], idx[k], idx[k + 1]}, matId});
                 }
             }
             for (int k = 1; k + 1 < n; ++k) {  // fan triangulation (OBJ faces are convex)
@@ -583,10 +584,47 @@ void loadObj(const std::string& path, const std::string& where, int overrideMate
             warnings.push_back(where + ": '" + path + "': the map_Kd of " + nameList(mapped) +
                                " is not rendered: the file has no texture coordinates (vt)");
     }
+    // An exporter that triangulates splits a rectangular light into two triangles along a
+    // diagonal: pair such triangles back into parallelogram lights. The rest are seen only.
+    size_t unlitFaces = 0;
+    std::vector<std::string> unlitMaterials;
+    std::vector<bool> paired(emissiveTriangles.size(), false);
+    for (size_t a = 0; a < emissiveTriangles.size(); ++a) {
+        if (paired[a]) continue;
+        const EmissiveTriangle& t = emissiveTriangles[a];
+        for (size_t b = a + 1; b < emissiveTriangles.size() && !paired[a]; ++b) {
+            const EmissiveTriangle& u = emissiveTriangles[b];
+            if (paired[b] || u.material != t.material) continue;
+            // t's corner k off the shared diagonal, u's vertex d off it: the quad is
+            // (t[k+1], t[k+2], ... ) ordered so that the diagonal joins its corners 0 and 2.
+            for (int k = 0; k < 3 && !paired[a]; ++k) {
+                const uint32_t s1 = t.v[(k + 2) % 3], off = t.v[k], s2 = t.v[(k + 1) % 3];
+                int shared = 0, d = -1;
+                for (uint32_t w : u.v) {
+                    if (w == s1 || w == s2) ++shared;
+                    else if (w != off) d = int(w);
+                }
+                if (shared != 2 || d < 0) continue;
+                const Vec3f q[4] = {mesh.positions[s1], mesh.positions[off], mesh.positions[s2], mesh.positions[uint32_t(d)]};
+                ParallelogramLight light;
+                if (asParallelogram(q, light)) {
+                    light.radiance = materials[t.material].emission;
+                    promoted.push_back(light);
+                    paired[a] = paired[b] = true;
+                }
+            }
+        }
+        if (!paired[a]) {
+            ++unlitFaces;
+            if (std::find(unlitMaterials.begin(), unlitMaterials.end(), materials[t.material].name) == unlitMaterials.end())
+                unlitMaterials.push_back(materials[t.material].name);
+        }
+    }
     if (unlitFaces > 0) {
-        warnings.push_back(where + ": '" + path + "': " + std::to_string(unlitFaces) + " emissive face(s) of " + nameList(unlitMaterials) +
-                           " are not parallelograms: they are only seen and light nothing (only parallelogram "
-                           "faces become lights)");
+        warnings.push_back(where + ": '" + path + "': " + std::to_string(unlitFaces) + " emissive triangle(s) of " +
+                           nameList(unlitMaterials) +
+                           " form no parallelogram: they are only seen and light nothing (only parallelogram faces, or "
+                           "two triangles that make one, become lights)");
     }
     // Corners without a `vn` (a scanned mesh has none) shade smoothly across edges under
     // kCreaseDegrees: per-triangle normals of a fine scan differ by tens of degrees between
