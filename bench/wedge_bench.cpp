@@ -1,5 +1,6 @@
 // Google Benchmark for the hot paths: sample generation, path sampling (rays/s on a built-in
-// scene), and the image-space filters (AAF, MAAF accumulation and filter) on rendered buffers.
+// scene), the image-space filters (AAF, MAAF accumulation and filter) on rendered buffers, and
+// loading a large OBJ (the text check and the whole load).
 // Run: make bench  (or build/bench/wedge_bench --benchmark_filter=...).
 #include <benchmark/benchmark.h>
 
@@ -8,7 +9,9 @@
 #include "core/sampler.h"
 #include "filter/aaf.h"
 #include "filter/maaf.h"
+#include "io/text_file.h"
 #include "render/renderer.h"
+#include "scene/obj_check.h"
 #include "scene/scene.h"
 #include "scene/scene_loader.h"
 
@@ -154,6 +157,21 @@ void BM_MaafFilter(benchmark::State& state) {
     state.SetItemsProcessed(state.iterations() * W * H);
 }
 BENCHMARK(BM_MaafFilter)->Unit(benchmark::kMillisecond);
+
+/// The OBJ text check (scene/obj_check.h) on sponza's 26 MB, which runs beside tinyobjloader's
+/// parse; bytes per second.
+void BM_ObjCheck(benchmark::State& state) {
+    const std::string text = io::readTextFile(scene::scenesDirectory() + "/sponza/sponza.obj");
+    for (auto _ : state) benchmark::DoNotOptimize(scene::checkObjText(text, "bench", "sponza.obj"));
+    state.SetBytesProcessed(int64_t(state.iterations()) * int64_t(text.size()));
+}
+BENCHMARK(BM_ObjCheck)->Unit(benchmark::kMillisecond);
+
+/// Loading sponza (the checked parse, materials, normals) as a scene description.
+void BM_LoadSponza(benchmark::State& state) {
+    for (auto _ : state) benchmark::DoNotOptimize(scene::loadScene("sponza").triangleCount());
+}
+BENCHMARK(BM_LoadSponza)->Unit(benchmark::kMillisecond)->Iterations(3);
 
 }  // namespace
 
