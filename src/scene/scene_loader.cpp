@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <unordered_map>
 #include <sstream>
 
 #include "core/error.h"
@@ -589,10 +590,24 @@ void loadObj(const std::string& path, const std::string& where, int overrideMate
     size_t unlitFaces = 0;
     std::vector<std::string> unlitMaterials;
     std::vector<bool> paired(emissiveTriangles.size(), false);
+    // A triangle's candidates are those sharing an edge with it, found by edge instead of by
+    // comparing every pair (an emissive mesh of 69K triangles would take 2.4e9 comparisons).
+    auto edgeKey = [](uint32_t i, uint32_t j) { return i < j ? uint64_t(i) << 32 | j : uint64_t(j) << 32 | i; };
+    std::unordered_map<uint64_t, std::vector<size_t>> byEdge;
+    for (size_t a = 0; a < emissiveTriangles.size(); ++a)
+        for (int k = 0; k < 3; ++k) byEdge[edgeKey(emissiveTriangles[a].v[k], emissiveTriangles[a].v[(k + 1) % 3])].push_back(a);
+    std::vector<size_t> candidates;
     for (size_t a = 0; a < emissiveTriangles.size(); ++a) {
         if (paired[a]) continue;
         const EmissiveTriangle& t = emissiveTriangles[a];
-        for (size_t b = a + 1; b < emissiveTriangles.size() && !paired[a]; ++b) {
+        candidates.clear();
+        for (int k = 0; k < 3; ++k)
+            for (size_t b : byEdge[edgeKey(t.v[k], t.v[(k + 1) % 3])])
+                if (b > a) candidates.push_back(b);
+        std::sort(candidates.begin(), candidates.end());  // the file's order decides, as for every pair
+        candidates.erase(std::unique(candidates.begin(), candidates.end()), candidates.end());
+        for (size_t i = 0; i < candidates.size() && !paired[a]; ++i) {
+            const size_t b = candidates[i];
             const EmissiveTriangle& u = emissiveTriangles[b];
             if (paired[b] || u.material != t.material) continue;
             // t's corner k off the shared diagonal, u's vertex d off it: the quad is
