@@ -48,12 +48,19 @@ Vec3f readScale(JsonNode node) {
     return Vec3f(float(node.positive()));
 }
 
-/// "'a', 'b', 'c' and 2 more": a few names for a warning.
-std::string nameList(const std::vector<std::string>& names) {
+/// "a, b, c and 2 more": the first few items for a warning.
+std::string fewOf(const std::vector<std::string>& items) {
     std::string s;
-    for (size_t i = 0; i < names.size() && i < 3; ++i) s += (i ? ", '" : "'") + names[i] + "'";
-    if (names.size() > 3) s += " and " + std::to_string(names.size() - 3) + " more";
+    for (size_t i = 0; i < items.size() && i < 3; ++i) s += (i ? ", " : "") + items[i];
+    if (items.size() > 3) s += " and " + std::to_string(items.size() - 3) + " more";
     return s;
+}
+
+/// "'a', 'b', 'c' and 2 more".
+std::string nameList(const std::vector<std::string>& names) {
+    std::vector<std::string> quoted;
+    for (const std::string& n : names) quoted.push_back("'" + n + "'");
+    return fewOf(quoted);
 }
 
 /// Accepts a 4-vertex face as a parallelogram light if v2 = v0 + e1 + e2 up to rounding.
@@ -332,10 +339,6 @@ private:
     std::map<std::string, uint32_t> m_materialIndex;
 };
 
-}  // namespace
-
-namespace {
-
 /// tinyobjloader's parse of `path`, with the text checks of obj_check.h run beside it: a
 /// malformed number reads as 0 and a grey MTL colour as red in tinyobjloader, so the check's
 /// error, if any, is the one reported (whichever finished first; on sponza the check takes
@@ -463,12 +466,8 @@ std::vector<uint32_t> appendMtlMaterials(const std::string& path, const std::str
         unused += std::string(unused.empty() ? "" : "; ") + "the bump, alpha and normal maps of " + nameList(textured);
     if (!transparent.empty())
         unused += std::string(unused.empty() ? "" : "; ") + "the transparency (d < 1) of " + nameList(transparent);
-    if (!maps.empty()) {
-        std::string list;  // already quoted, with the reason
-        for (size_t i = 0; i < maps.size() && i < 3; ++i) list += (i ? ", " : "") + maps[i];
-        if (maps.size() > 3) list += " and " + std::to_string(maps.size() - 3) + " more";
-        unused += std::string(unused.empty() ? "" : "; ") + "the diffuse maps of " + list;
-    }
+    if (!maps.empty())  // already quoted, with the reason
+        unused += std::string(unused.empty() ? "" : "; ") + "the diffuse maps of " + fewOf(maps);
     if (!unused.empty())
         warnings.push_back(where + ": '" + path + "': " + unused +
                            " are not rendered (surfaces are Lambertian with the MTL's Kd and PNG map_Kd)");
