@@ -13,6 +13,7 @@
 #include "core/parallel.h"
 #include "core/sampler.h"
 #include "io/image_io.h"
+#include "io/text_file.h"
 
 namespace fs = std::filesystem;
 
@@ -54,13 +55,6 @@ std::string fileStem(const std::string& name) {
 uint64_t fnv1a(const std::string& bytes, uint64_t h = 1469598103934665603ULL) {
     for (unsigned char c : bytes) h = (h ^ c) * 1099511628211ULL;
     return h;
-}
-
-std::string readFile(const std::string& path) {
-    std::ifstream in(path, std::ios::binary);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
 }
 
 void writeTextFile(const std::string& path, const std::string& text) {
@@ -181,7 +175,7 @@ private:
 
 void Experiment::loadOrRenderReference() {
     const auto& desc = m_scene.desc();
-    uint64_t hash = fnv1a(desc.file.empty() ? std::string() : readFile(desc.file));
+    uint64_t hash = fnv1a(fs::is_regular_file(desc.file) ? io::readTextFile(desc.file) : std::string());
     hash = fnv1a(std::to_string(desc.triangleCount()) + "/" + std::to_string(desc.lights.size()), hash);
     char key[256];
     std::snprintf(key, sizeof key, "reference-%s-%dx%d-%dspp-seed%u-%016" PRIx64, fileStem(m_result.scene).c_str(),
@@ -191,7 +185,7 @@ void Experiment::loadOrRenderReference() {
     if (fs::is_regular_file(exr) && fs::is_regular_file(meta)) {
         try {
             m_reference = io::readColor(exr.string());
-            nlohmann::json j = nlohmann::json::parse(readFile(meta.string()));
+            nlohmann::json j = nlohmann::json::parse(io::readTextFile(meta.string()));
             m_result.referenceSeconds = j.at("seconds").get<double>();
             m_result.referenceNoise = j.at("noise_relmse").get<double>();  // older entries lack it: render again
             if (m_reference.sameSize(m_result.width, m_result.height)) {
@@ -621,7 +615,7 @@ std::string Experiment::markdownTable() const {
 void Experiment::writeHtml() const {
     const fs::path out(m_options.outDir);
     auto embed = [&](const std::string& relative) {
-        return "data:image/png;base64," + base64(readFile((out / relative).string()));
+        return "data:image/png;base64," + base64(io::readTextFile((out / relative).string()));
     };
     auto td = [](const std::string& s) { return "<td>" + s + "</td>"; };
     const ExperimentRow* anchor = nullptr;
