@@ -2,8 +2,7 @@
 
 #include <cmath>
 #include <filesystem>
-#include <fstream>
-#include <sstream>
+#include <set>
 
 #include "core/error.h"
 #include "io/text_file.h"

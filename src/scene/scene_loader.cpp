@@ -10,10 +10,8 @@
 #include <cstdlib>
 #include <exception>
 #include <filesystem>
-#include <fstream>
 #include <map>
 #include <unordered_map>
-#include <sstream>
 
 #include "core/error.h"
 #include "core/image.h"
