@@ -72,9 +72,13 @@ Scene::Scene(SceneDesc desc) : m_desc(std::move(desc)) {
     rtcSetSceneFlags(m_scene, RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION);
     rtcSetSceneBuildQuality(m_scene, RTC_BUILD_QUALITY_HIGH);
 
+    // Time step 0 at shutter open, 1 at close (rays carry the normalised shutter time); an
+    // object moves by velocity x (close - open) in between (scene_desc.h).
+    const float shutter = m_desc.camera.shutterLength();
     uint32_t object = 0;
     for (const TriangleMesh& mesh : m_desc.meshes) {
         bool moving = mesh.velocity != Vec3f(0.f);
+        const Vec3f displacement = mesh.velocity * shutter;
         RTCGeometry geom = rtcNewGeometry(m_device, RTC_GEOMETRY_TYPE_TRIANGLE);
         rtcSetGeometryBuildQuality(geom, moving ? RTC_BUILD_QUALITY_MEDIUM : RTC_BUILD_QUALITY_HIGH);
         unsigned steps = moving ? 2 : 1;
@@ -83,8 +87,7 @@ Scene::Scene(SceneDesc desc) : m_desc(std::move(desc)) {
             // Embree allocates the buffer with the padding its SIMD loads need.
             auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, s, RTC_FORMAT_FLOAT3,
                                                                   3 * sizeof(float), mesh.positions.size()));
-            // Time step 0 at shutter open, 1 at close (rays carry the normalised shutter time).
-            Vec3f offset = mesh.velocity * (float(s) * m_desc.camera.shutterLength());
+            Vec3f offset = displacement * float(s);
             for (size_t i = 0; i < mesh.positions.size(); ++i) {
                 Vec3f p = mesh.positions[i] + offset;
                 v[3 * i] = p.x; v[3 * i + 1] = p.y; v[3 * i + 2] = p.z;
@@ -101,7 +104,7 @@ Scene::Scene(SceneDesc desc) : m_desc(std::move(desc)) {
         if (m_geometry.size() <= id) m_geometry.resize(id + 1);
         m_geometry[id] = {mesh.materialIds.data(), mesh.shapeIds.data(), 0, object, false,
                           mesh.cornerNormals.size() == mesh.indices.size() ? mesh.cornerNormals.data() : nullptr,
-                          mesh.velocity * m_desc.camera.shutterLength(),
+                          displacement,
                           mesh.cornerUVs.size() == mesh.indices.size() ? mesh.cornerUVs.data() : nullptr};
         uint32_t shapes = 0;
         for (uint32_t sId : mesh.shapeIds) shapes = std::max(shapes, sId + 1);
@@ -119,7 +122,7 @@ Scene::Scene(SceneDesc desc) : m_desc(std::move(desc)) {
                                                                   4 * sizeof(float), m_desc.spheres.size()));
             for (size_t i = 0; i < m_desc.spheres.size(); ++i) {
                 const Sphere& sp = m_desc.spheres[i];
-                Vec3f c = sp.center + sp.velocity * (float(s) * m_desc.camera.shutterLength());
+                Vec3f c = sp.center + sp.velocity * shutter * float(s);
                 v[4 * i] = c.x; v[4 * i + 1] = c.y; v[4 * i + 2] = c.z; v[4 * i + 3] = sp.radius;
                 m_lo = vmin(m_lo, c - Vec3f(sp.radius));
                 m_hi = vmax(m_hi, c + Vec3f(sp.radius));
