@@ -13,8 +13,7 @@ namespace wedge::scene {
 
 namespace {
 
-/// Splits text into lines (without '\n' or a trailing '\r') and a line into tokens separated
-/// by spaces and tabs, as tinyobjloader does.
+/// Splits text into lines, without '\n' or a trailing '\r', as tinyobjloader does.
 class LineReader {
 public:
     explicit LineReader(std::string_view text) : m_text(text) {}
@@ -53,9 +52,15 @@ void splitTokens(std::string_view line, std::vector<std::string_view>& out, bool
     }
 }
 
+/// from_chars takes no leading '+', which tinyobjloader (and strtod) accept.
+std::string_view withoutPlus(std::string_view token) {
+    if (token.size() > 1 && token[0] == '+' && token[1] != '-') token.remove_prefix(1);
+    return token;
+}
+
 /// A whole token as a finite float ("+1.5", ".5", "1e-3"; not "nan", "inf", "1e39", "0.5.5", "1,5").
 bool parseNumber(std::string_view token, double& value) {
-    if (token.size() > 1 && token[0] == '+' && token[1] != '-') token.remove_prefix(1);
+    token = withoutPlus(token);
     const char* end = token.data() + token.size();
     auto [ptr, ec] = std::from_chars(token.data(), end, value, std::chars_format::general);
     // Within float's range: tinyobjloader and the renderer keep floats.
@@ -63,7 +68,7 @@ bool parseNumber(std::string_view token, double& value) {
 }
 
 bool parseInteger(std::string_view token, long long& value) {
-    if (token.size() > 1 && token[0] == '+' && token[1] != '-') token.remove_prefix(1);
+    token = withoutPlus(token);
     const char* end = token.data() + token.size();
     auto [ptr, ec] = std::from_chars(token.data(), end, value);
     return ec == std::errc() && ptr == end;
