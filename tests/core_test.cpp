@@ -177,12 +177,7 @@ TEST(ImageIo, BadFilesAreErrors) {
 
 /// The message of the Error that reading `path` throws ("" if none).
 std::string readError(const std::string& path) {
-    try {
-        io::readColor(path);
-    } catch (const Error& e) {
-        return e.what();
-    }
-    return "";
+    return test::errorOf([&] { io::readColor(path); });
 }
 
 TEST(ImageIo, HeadersAreCheckedBeforeAllocating) {

@@ -185,16 +185,7 @@ TEST(Scene, SmoothNormalsBlendShallowFoldsAndKeepCreases) {
 
 namespace {
 
-/// The message of the Error that `check` throws, or "" if it throws none.
-template <class Check>
-std::string errorOf(Check&& check) {
-    try {
-        check();
-    } catch (const Error& e) {
-        return e.what();
-    }
-    return "";
-}
+using test::errorOf;
 
 std::string objError(const std::string& obj) {
     return errorOf([&] { checkObjText(obj, "s.json: objects[0].file", "m.obj"); });

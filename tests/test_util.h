@@ -1,9 +1,22 @@
-// Shared helpers for the tests: temporary directories, running the CLI, tiny scenes.
+// Shared helpers for the tests: temporary directories, running the CLI, an Error's message.
 #pragma once
 
 #include <string>
 
+#include "core/error.h"
+
 namespace wedge::test {
+
+/// The message of the wedge::Error that `run` throws, or "" if it throws none.
+template <class Fn>
+std::string errorOf(Fn&& run) {
+    try {
+        run();
+    } catch (const Error& e) {
+        return e.what();
+    }
+    return "";
+}
 
 /// A fresh empty directory under the system temp dir, removed at process exit.
 std::string tempDir();
