@@ -1,7 +1,6 @@
 // Render module: the path sampler against closed forms (direct light from a parallelogram,
 // one-bounce indirect in a sphere, the thin-lens circle of confusion, the motion blur of a
-// moving emitter) and determinism across
-// thread counts.
+// moving emitter) and determinism across thread counts.
 #include <gtest/gtest.h>
 
 #include <cmath>
