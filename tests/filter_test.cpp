@@ -627,6 +627,30 @@ TEST(MaafWeights, SamplingSpectraAreTheDensitiesCharacteristicFunctions) {
     }
 }
 
+TEST(MaafWeights, TriangleSpectrumIsTheTrianglesCharacteristicFunction) {
+    // E[cos(w (y - mean))] for y = a e1 + b e2, (a, b) uniform on the triangle a, b >= 0,
+    // a + b <= 1, by the midpoint rule on a fine grid of the triangle's sub-triangles, against the
+    // closed form; a tiny w takes the series branch continuously.
+    auto numeric = [](double w, double e1, double e2) {
+        const int n = 400;
+        const double mean = (e1 + e2) / 3;
+        double sum = 0;
+        for (int i = 0; i < n; ++i)
+            for (int j = 0; i + j < n; ++j) {
+                // The two sub-triangles of cell (i, j) (one where i + j = n - 1), by their centroids.
+                sum += std::cos(w * (((i + 1.0 / 3) * e1 + (j + 1.0 / 3) * e2) / n - mean));
+                if (i + j < n - 1) sum += std::cos(w * (((i + 2.0 / 3) * e1 + (j + 2.0 / 3) * e2) / n - mean));
+            }
+        return sum / (double(n) * n);
+    };
+    for (auto [e1, e2] : {std::pair{0.8, 0.3}, {-0.5, 0.9}, {0.6, 0.6}, {0.0, 1.2}, {1.0, -1.0}})
+        for (double w : {0.0, 0.5, 2.0, 5.0, 11.0}) {
+            EXPECT_NEAR(triangleSpectrum(w, e1, e2), numeric(w, e1, e2), 1e-4) << e1 << " " << e2 << " w = " << w;
+            EXPECT_NEAR(triangleSpectrum(-w, e1, e2), triangleSpectrum(w, e1, e2), 1e-12);
+        }
+    EXPECT_NEAR(triangleSpectrum(1e-6, 0.3, 0.9), triangleSpectrum(2e-4, 0.3, 0.9), 1e-7);
+}
+
 namespace {
 /// RMS bias of the expected MAAF output across a flatland penumbra under a strip light 1 long
 /// and 1 / aspect wide, seen along its length (analysis/penumbra.h: the renderer's kernel, samples

@@ -439,14 +439,6 @@ TEST(RasterTexture, UnfilteredItIsTheRayTracersChecker) {
     EXPECT_LT(dark, 300);
 }
 
-TEST(RasterShader, PolygonIrradianceOfAHugeLightIsPi) {
-    scene::ParallelogramLight l{{-500, -500, 1}, {0, 1000, 0}, {1000, 0, 0}, Vec3f(1.f)};  // faces -z
-    EXPECT_NEAR(polygonIrradiance(l, {0, 0, 0}, {0, 0, 1}), kPi, 0.01f);
-    EXPECT_NEAR(polygonIrradiance(l, {0, 0, 0}, {0, 0, -1}), 0.f, 1e-6f);     // facing away
-    EXPECT_NEAR(polygonIrradiance(l, {0, 0, 2}, {0, 0, -1}), 0.f, 1e-6f);     // behind the light
-    EXPECT_NEAR(polygonIrradiance(l, {0, 0, 0}, {1, 0, 0}), kPi / 2, 0.02f);  // half the hemisphere, cosine-weighted
-}
-
 // --- Command line -----------------------------------------------------------------------------
 
 TEST(RasterCli, WritesImageAndStats) {

@@ -3,10 +3,12 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <tuple>
 
 #include "core/error.h"
 #include "io/image_io.h"
 #include "scene/checker.h"
+#include "scene/light_irradiance.h"
 #include "scene/obj_check.h"
 #include "scene/scene.h"
 #include "scene/scene_loader.h"
@@ -46,9 +48,53 @@ TEST(Scene, TriangleNormalIsCounterClockwise) {
 }
 
 TEST(Scene, LightNormalFollowsEdges) {
-    ParallelogramLight l{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, Vec3f(1.f)};
+    AreaLight l{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, Vec3f(1.f)};
     EXPECT_NEAR(l.normal().z, 1.f, 1e-6f);
     EXPECT_NEAR(l.area(), 1.f, 1e-6f);
+}
+
+TEST(Scene, TriangleLightSamplesAreUniformOnTheTriangle) {
+    // The unit square's cell centres fold onto the triangle: every point inside, their mean the
+    // centroid, and each of the triangle's four midpoint sub-triangles takes a quarter of them.
+    AreaLight l{{1, 2, 3}, {2, 0, 0.5f}, {0.5f, 0, 1.5f}, Vec3f(1.f), AreaLight::Shape::Triangle};
+    EXPECT_NEAR(l.area(), 0.5f * length(cross(l.edge1, l.edge2)), 1e-6f);
+    const int n = 64;
+    Vec3f mean(0.f);
+    int quarter[4] = {};
+    for (int i = 0; i < n; ++i)
+        for (int j = 0; j < n; ++j) {
+            const Vec3f p = l.pointAt((i + 0.5f) / n, (j + 0.5f) / n);
+            mean += p / float(n * n);
+            // (a, b) with p = corner + a edge1 + b edge2: the edges' coordinates in their plane.
+            const Vec3f d = p - l.corner, c = cross(l.edge1, l.edge2);
+            const float a = dot(cross(d, l.edge2), c) / dot(c, c), b = dot(cross(l.edge1, d), c) / dot(c, c);
+            ASSERT_GE(a, -1e-5f);
+            ASSERT_GE(b, -1e-5f);
+            ASSERT_LE(a + b, 1 + 1e-5f);
+            ++quarter[a > 0.5f ? 1 : b > 0.5f ? 2 : a + b < 0.5f ? 0 : 3];
+        }
+    EXPECT_LT(length(mean - l.center()), 1e-3f);  // the diagonal cells sit on the hypotenuse: O(1/n)
+    for (int q : quarter) EXPECT_NEAR(q, n * n / 4, n / 2) << "a sub-triangle's share";
+    Vec3f v[4];
+    EXPECT_EQ(l.vertices(v), 3);
+    EXPECT_EQ(v[2], l.corner + l.edge2);
+}
+
+TEST(Scene, TwoTriangleLightsIrradianceIsTheirParallelograms) {
+    // Lambert's formula is additive over the polygon: a parallelogram's two halves as triangle
+    // lights give its irradiance, also where the receiver's horizon clips them.
+    const AreaLight quad{{-0.5f, 2, -0.3f}, {1.2f, 0, 0.1f}, {0.2f, 0.1f, 0.9f}, Vec3f(3.f, 2.f, 1.f)};
+    const Vec3f far = quad.corner + quad.edge1 + quad.edge2;
+    const AreaLight t1{quad.corner, quad.edge1, quad.edge2, quad.radiance, AreaLight::Shape::Triangle};
+    const AreaLight t2{far, -quad.edge1, -quad.edge2, quad.radiance, AreaLight::Shape::Triangle};
+    const Vec3f receivers[][2] = {{{0, 0, 0}, {0, 1, 0}},                            // facing it
+                                  {{0.3f, 0.5f, 0.2f}, normalize(Vec3f(1, 0.4f, 0))},  // clipped by the horizon
+                                  {{0.2f, 1.5f, 0.3f}, {1, 0, 0}}};                   // under it, cut in two
+    for (const auto& r : receivers) {
+        const Vec3f whole = unoccludedIrradiance({quad}, r[0], r[1]), halves = unoccludedIrradiance({t1, t2}, r[0], r[1]);
+        ASSERT_GT(whole.x, 0.f);
+        for (int c = 0; c < 3; ++c) EXPECT_NEAR(halves[c], whole[c], 1e-5f * whole[c]);
+    }
 }
 
 TEST(Scene, OccluderSpanFindsNearestAndFarthest) {
@@ -199,7 +245,7 @@ std::string mtlError(const std::string& mtl) {
 struct LoadedObj {
     std::vector<Material> materials;
     TriangleMesh mesh;
-    std::vector<ParallelogramLight> promoted;
+    std::vector<AreaLight> promoted;
     std::vector<std::string> warnings;
 };
 LoadedObj loadObjFile(const std::string& path, const std::string& where = "w") {
@@ -330,9 +376,10 @@ TEST(ObjCheck, ShippedMeshesPass) {
     EXPECT_EQ(mtls, 4) << "the two Cornell boxes', conference's and sponza's";
 }
 
-TEST(SceneFile, EmittersThatLightNothingAreNamed) {
-    // Only the scene's parallelograms and the emissive quads and OBJ parallelogram faces that do
-    // not move are lights; other emitters are seen but light nothing, which used to pass silently.
+TEST(SceneFile, EmittersBecomeLightsOrAreNamed) {
+    // The scene's lights, and the faces of emissive quads, boxes and OBJ meshes that do not move,
+    // are lights; spheres and moving emitters are seen but light nothing, which used to pass
+    // silently, and so are emitters past kMaxLights.
     auto warningsOf = [](const std::string& objects, const std::string& dir = ".") {
         const std::string json = R"({
           "camera": {"position": [0, 1, 3], "look_at": [0, 0, 0], "up": [0, 1, 0], "fov_y": 40, "resolution": [8, 8]},
@@ -347,29 +394,55 @@ TEST(SceneFile, EmittersThatLightNothingAreNamed) {
     auto [quad, quadLights] = warningsOf(R"({"type": "quad", "corner": [0, 1, 0], "edge1": [1, 0, 0], "edge2": [0, 0, 1], "material": "glow"})");
     EXPECT_EQ(quad, "");
     EXPECT_EQ(quadLights, 2u) << "a still emissive quad is a light";
+    auto [box, boxLights] = warningsOf(R"({"type": "box", "min": [0, 0, 0], "max": [1, 1, 1], "material": "glow"})");
+    EXPECT_EQ(box, "");
+    EXPECT_EQ(boxLights, 7u) << "a box's six faces are lights";
     auto [sphere, sphereLights] = warningsOf(R"({"type": "sphere", "center": [0, 0, 0], "radius": 0.5, "material": "glow"})");
-    EXPECT_EQ(sphere, "s.json: objects[0]: material 'glow' emits, but a sphere is only seen: it lights nothing (lights are the "
-                      "scene's parallelograms and the emissive quads and OBJ parallelogram faces that do not move)\n");
+    EXPECT_EQ(sphere, "s.json: objects[0]: material 'glow' emits, but a sphere is only seen: it lights nothing (spheres are not lights)\n");
     EXPECT_EQ(sphereLights, 1u);
-    EXPECT_NE(warningsOf(R"({"type": "box", "min": [0, 0, 0], "max": [1, 1, 1], "material": "glow"})").first.find("a box is only seen"),
-              std::string::npos);
-    EXPECT_NE(warningsOf(R"({"type": "quad", "corner": [0, 1, 0], "edge1": [1, 0, 0], "edge2": [0, 0, 1], "material": "glow", "velocity": [1, 0, 0]})")
-                  .first.find("a moving quad is only seen"),
-              std::string::npos);
+    auto [moving, movingLights] = warningsOf(
+        R"({"type": "box", "min": [0, 0, 0], "max": [1, 1, 1], "material": "glow", "velocity": [1, 0, 0]})");
+    EXPECT_EQ(moving, "s.json: objects[0]: the 6 emissive face(s) of this box are only seen and light nothing: moving emitters are not lights\n");
+    EXPECT_EQ(movingLights, 1u);
 
     std::string dir = test::tempDir();
     test::writeFile(dir + "/lamp.obj", "mtllib lamp.mtl\nv 0 2 0\nv 1 2 0\nv 0 2 1\nv 1 2 1\nusemtl lamp\nf 1 2 3\nf 1 3 4 2\n");
     test::writeFile(dir + "/lamp.mtl", "newmtl lamp\nKd 0 0 0\nKe 9 9 9\n");
     auto [obj, objLights] = warningsOf(R"({"type": "mesh", "file": "lamp.obj"})", dir);
-    EXPECT_NE(obj.find("s.json: objects[0].file: '" + dir + "/lamp.obj': 1 emissive triangle(s) of 'lamp.obj:lamp' form no parallelogram"),
-              std::string::npos)
-        << obj;
-    EXPECT_EQ(objLights, 2u) << "the parallelogram face is a light, the triangle is not";
+    EXPECT_EQ(obj, "");
+    EXPECT_EQ(objLights, 3u) << "the parallelogram face and the triangle are lights";
+    auto [movingObj, movingObjLights] = warningsOf(R"({"type": "mesh", "file": "lamp.obj", "velocity": [0, 1, 0]})", dir);
+    EXPECT_EQ(movingObj, "s.json: objects[0]: the 2 emissive face(s) of 'lamp.obj' are only seen and light nothing: moving emitters are not lights\n");
+    EXPECT_EQ(movingObjLights, 1u);
+
+    // kMaxLights: 300 separate emissive triangles would make 301 lights; none of them is one.
+    std::string many = "mtllib lamp.mtl\nusemtl lamp\n";
+    for (int i = 0; i < 300; ++i) {
+        const std::string x = std::to_string(i * 0.01), x2 = std::to_string(i * 0.01 + 0.005);
+        many += "v " + x + " 1 0\nv " + x + " 1 0.005\nv " + x2 + " 1 0\nf -3 -2 -1\n";
+    }
+    test::writeFile(dir + "/many.obj", many);
+    auto [tooMany, tooManyLights] = warningsOf(R"({"type": "mesh", "file": "many.obj"})", dir);
+    EXPECT_EQ(tooMany, "s.json: objects[0]: the 300 emissive face(s) of 'many.obj' are only seen and light nothing: the scene "
+                       "has 1 lights before them and takes 256 at most\n");
+    EXPECT_EQ(tooManyLights, 1u);
+    std::string lights;
+    for (size_t i = 0; i <= kMaxLights; ++i)
+        lights += std::string(i ? ", " : "") +
+                  R"({"type": "triangle", "corner": [0, 2, 0], "edge1": [0, 0, 1], "edge2": [1, 0, 0], "radiance": [1, 1, 1]})";
+    EXPECT_EQ(test::errorOf([&] {
+                  parseScene(R"({"camera": {"position": [0, 1, 3], "look_at": [0, 0, 0], "up": [0, 1, 0], "fov_y": 40, "resolution": [8, 8]},
+                                 "lights": [)" + lights + R"(], "materials": {"w": {"albedo": [1, 1, 1]}},
+                                 "objects": [{"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "w"}]})",
+                             "s.json", ".");
+              }),
+              "s.json: lights[256]: more than 256 lights (MAAF keeps a light's index in a byte)");
 }
 
-TEST(SceneFile, TwoEmissiveTrianglesThatMakeAParallelogramAreALight) {
+TEST(SceneFile, EmissiveTrianglesAreLightsAndPairsThatMakeAParallelogramOne) {
     // A triangulating exporter splits a rectangular light along one diagonal or the other; the
-    // two triangles become one parallelogram light again, facing as they do.
+    // two triangles become one parallelogram light again, facing as they do. Triangles that make
+    // no parallelogram are triangle lights.
     std::string dir = test::tempDir();
     test::writeFile(dir + "/lamp.mtl", "newmtl lamp\nKd 0 0 0\nKe 9 9 9\n");
     const std::string corners = "mtllib lamp.mtl\nv 0 2 0\nv 0 2 1\nv 2 2 1\nv 2 2 0\nusemtl lamp\n";  // wound to face +y
@@ -378,17 +451,27 @@ TEST(SceneFile, TwoEmissiveTrianglesThatMakeAParallelogramAreALight) {
         LoadedObj o = loadObjFile(dir + "/lamp.obj");
         ASSERT_EQ(o.promoted.size(), 1u) << faces;
         EXPECT_TRUE(o.warnings.empty()) << o.warnings[0];
-        const ParallelogramLight& l = o.promoted[0];
+        const AreaLight& l = o.promoted[0];
+        EXPECT_FALSE(l.triangle());
         EXPECT_NEAR(l.area(), 2.f, 1e-6f) << faces;
         EXPECT_NEAR(l.normal().y, 1.f, 1e-6f) << faces;  // as each triangle faces
         EXPECT_EQ(l.radiance, Vec3f(9.f));
     }
-    // Not a parallelogram (a kite), or two triangles with one corner in common: seen only.
-    for (const char* faces : {"v 1 2 -3\nf 1 2 3\nf 1 3 5\n", "f 1 2 3\nf 3 4 1\nf 1 2 4\n"}) {
+    // Not a parallelogram (a kite: areas 1 and 3.5), or a third triangle over two that pair:
+    // triangle lights, facing as their faces do.
+    for (auto [faces, lights, triangleArea] : {std::tuple{"v 1 2 -3\nf 1 2 3\nf 1 3 5\n", 2u, 4.5f},
+                                               std::tuple{"f 1 2 3\nf 3 4 1\nf 1 2 4\n", 2u, 1.f}}) {
         test::writeFile(dir + "/lamp.obj", corners + faces);
         LoadedObj o = loadObjFile(dir + "/lamp.obj");
-        ASSERT_EQ(o.warnings.size(), 1u) << faces;
-        EXPECT_NE(o.warnings[0].find("form no parallelogram"), std::string::npos) << o.warnings[0];
+        EXPECT_TRUE(o.warnings.empty()) << o.warnings[0];
+        ASSERT_EQ(o.promoted.size(), lights) << faces;
+        float area = 0;
+        for (const AreaLight& l : o.promoted)
+            if (l.triangle()) {
+                area += l.area();
+                EXPECT_NEAR(std::abs(l.normal().y), 1.f, 1e-6f);
+            }
+        EXPECT_NEAR(area, triangleArea, 1e-5f) << faces;
     }
 }
 
@@ -406,7 +489,7 @@ TEST(SceneFile, ObjDiffuseMapsTextureTheAlbedo) {
                                     "usemtl m\nf 1/1 2/2 3/3 4/4\n");
     test::writeFile(dir + "/q.mtl", "newmtl m\nKd 0.5 0.5 0.5\nmap_Kd t.png\n");
     SceneDesc d;
-    std::vector<ParallelogramLight> promoted;
+    std::vector<AreaLight> promoted;
     loadObj(dir + "/q.obj", "s.json: objects[0].file", -1, d.materials, d.meshes.emplace_back(), promoted, d.warnings);
     ASSERT_EQ(d.materials.size(), 1u);
     ASSERT_TRUE(d.materials[0].map);

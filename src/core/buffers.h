@@ -36,7 +36,8 @@ struct ViewGeometry {
     float focusDistance = 1;   // world, along forward
     struct Light {
         Vec3f center, normal, axisA, axisB;  // axisA/B: orthonormal in the light plane
-        Vec3f edge1{0.f}, edge2{0.f};          // the parallelogram's edges (a point is center + a edge1 + b edge2, |a|, |b| <= 1/2)
+        Vec3f edge1{0.f}, edge2{0.f};          // the edges from the corner (scene::AreaLight)
+        bool triangle = false;               // the triangle (corner, +edge1, +edge2), else the parallelogram
         float sigma = 1;                     // Gaussian model of the light: sqrt(area)/2
         float power = 1;                     // luminance of radiance x area
     };

@@ -22,9 +22,10 @@ struct AxisInputs {
     double omegaU = 6;
     double step = 1;                        // world size of a pixel along the axis
     bool fallback = false;
-    // The density y is sampled from: a parallelogram light whose edges project to lengths
-    // (edge1, edge2) on the axis, or the unit disc of a cosine-weighted bounce.
-    bool light = false;
+    // The density y is sampled from: a light whose edges from its corner project to (edge1,
+    // edge2) on the axis, a parallelogram or a triangle, or the unit disc of a cosine-weighted
+    // bounce.
+    bool light = false, triangle = false;
     double edge1 = 0, edge2 = 0;
 };
 
@@ -42,7 +43,9 @@ namespace {
 /// The spectrum of the densities a pixel's samples are drawn from at component c's centre: the
 /// light's (or the bounce's) along y, times the lens's along u (maaf.h, "Weights").
 double samplingSpectrum(const MaafComponent& c, const AxisInputs& in) {
-    double mu = in.light ? parallelogramSpectrum(c.cy, in.edge1, in.edge2) : discSpectrum(c.cy);
+    double mu = !in.light      ? discSpectrum(c.cy)
+                : in.triangle ? triangleSpectrum(c.cy, in.edge1, in.edge2)
+                              : parallelogramSpectrum(c.cy, in.edge1, in.edge2);
     return in.lens ? mu * discSpectrum(c.cu) : mu;
 }
 
@@ -160,13 +163,20 @@ MaafParams maafParams(const FrameBuffers& fb, const WedgeField& wf, const Filter
         return true;
     };
     // Direct: the shadow wedge in the light plane.
-    auto direct = [&, common, sigma, smallest, o](size_t p, int k, MaafAxis& out) {
+    // The outer components reproduce the sheared profile of one light (their weights are its
+    // spectrum, their y its coordinates): with several lights, whose samples share a pixel's
+    // accumulations, the direct filter is the central component (axis-aligned). Measured on
+    // a floor, a box and a plank under a large and a small parallelogram (16 spp, 384x384,
+    // against 512-spp MC): the outer components gave relMSE 0.00495, worse than MC's 0.00278.
+    const bool oneLight = view.lights.size() == 1;
+    auto direct = [&, common, sigma, smallest, oneLight, o](size_t p, int k, MaafAxis& out) {
         AxisInputs in;
         if (!common(p, in)) {
             out = MaafAxis{};
             out.pairs = 1;
             return;
         }
+        in.fallback = in.fallback || !oneLight;
         in.step = frames.direct[p].step[k];
         in.yWedge = wf.s2[p] < kInf;
         in.omegaY = o.mu / sigma;
@@ -176,8 +186,9 @@ MaafParams maafParams(const FrameBuffers& fb, const WedgeField& wf, const Filter
         in.suMax = wf.suMax[p] * in.step;
         const Vec3f& axis = frames.direct[p].axis[k];
         in.light = true;
-        in.edge1 = smallest ? std::abs(dot(smallest->edge1, axis)) : 0.0;
-        in.edge2 = smallest ? std::abs(dot(smallest->edge2, axis)) : 0.0;
+        in.triangle = smallest && smallest->triangle;
+        in.edge1 = smallest ? dot(smallest->edge1, axis) : 0.0;  // signed: a triangle's spectrum needs the sign
+        in.edge2 = smallest ? dot(smallest->edge2, axis) : 0.0;
         out = buildAxis(in, o);
     };
     // Indirect: the bounce wedge in the tangent plane (z clamped to zMinPixels pixel sizes);

@@ -34,8 +34,9 @@
 //    are drawn from the light's and the aperture's own densities, so the kernel over a sample's
 //    (y, u) is sum_p mu_p cos(C_y y + C_u u): a Fourier series that reproduces the sheared light
 //    profile only if mu_p is that density's spectrum at (C_y, C_u). By default mu_p is that
-//    spectrum: parallelogramSpectrum (sinc x sinc of the light's edges projected on the axis)
-//    times discSpectrum (2 J1(w) / w) for the lens; discSpectrum for the cosine-weighted bounce.
+//    spectrum: parallelogramSpectrum (sinc x sinc of the light's edges projected on the axis; a
+//    triangle light's triangleSpectrum) times discSpectrum (2 J1(w) / w) for the lens;
+//    discSpectrum for the cosine-weighted bounce.
 //    Checked numerically on a flatland penumbra (unbounded window, tests/filter_test.cpp,
 //    MaafWeights): N = 3's bias is 0.030 (eq. 10) vs 0.026 under a square light and 0.109 vs
 //    0.037 under a 4:1 strip seen along its length, whose sqrt(area) misstates the extent.

@@ -1,5 +1,6 @@
 #include "filter/maaf_components.h"
 
+#include <algorithm>
 #include <cmath>
 
 namespace wedge::filter {
@@ -47,6 +48,25 @@ double sinc(double x) { return std::abs(x) < 1e-8 ? 1.0 : std::sin(x) / x; }
 }  // namespace
 
 double parallelogramSpectrum(double w, double e1, double e2) { return sinc(0.5 * w * e1) * sinc(0.5 * w * e2); }
+
+double triangleSpectrum(double w, double e1, double e2) {
+    // The corners' projections, centred on the mean and sorted: x0 <= x1 <= x2.
+    const double c = (e1 + e2) / 3;
+    double x[3] = {-c, e1 - c, e2 - c};
+    std::sort(x, x + 3);
+    const double spread = x[2] - x[0];
+    if (std::abs(w) * spread < 1e-4) {  // E[cos(w y)] = 1 - w^2 Var(y) / 2 + O((w spread)^4)
+        const double var = (x[0] * x[0] + x[1] * x[1] + x[2] * x[2] - x[0] * x[1] - x[0] * x[2] - x[1] * x[2]) / 18;
+        return 1 - 0.5 * w * w * var;
+    }
+    // With e = e^{iwy}: e[a, b] = (e(b) - e(a)) / (b - a) = i w e^{iw(a+b)/2} sinc(w (b - a) / 2),
+    // 2 f[x0, x1, x2] = -(2 / w^2) (e[x1, x2] - e[x0, x1]) / (x2 - x0), whose real part is
+    // 2 / (w (x2 - x0)) (sin(w m12) sinc(w h12) - sin(w m01) sinc(w h01)), m the midpoints and
+    // h the half-lengths; stable once w (x2 - x0) is not tiny (sorting makes it the largest gap).
+    const double m12 = 0.5 * (x[1] + x[2]), h12 = 0.5 * (x[2] - x[1]);
+    const double m01 = 0.5 * (x[0] + x[1]), h01 = 0.5 * (x[1] - x[0]);
+    return 2 / (w * spread) * (std::sin(w * m12) * sinc(w * h12) - std::sin(w * m01) * sinc(w * h01));
+}
 
 double discSpectrum(double w) {
     double a = std::abs(w);

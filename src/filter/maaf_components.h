@@ -50,6 +50,12 @@ void maafComponents(int pairs, const WedgeShape& wedge, MaafComponent* out);
 /// y = the projection onto a unit axis of a point uniform on a parallelogram whose edges project
 /// to lengths e1 and e2 (a light): sinc(w e1 / 2) sinc(w e2 / 2);
 double parallelogramSpectrum(double w, double e1, double e2);
+/// y = the projection, taken from the centroid, of a point uniform on the triangle (0, e1, e2)
+/// whose edges from its first corner project to the signed lengths e1 and e2 (a triangle light):
+/// the real part of its characteristic function, 2 f[x0, x1, x2] for f = -e^{iwy} / w^2 by the
+/// Hermite-Genocchi formula. Unlike a parallelogram's, the density is not symmetric about its
+/// centre, and a kernel of cosines reproduces its symmetric part only.
+double triangleSpectrum(double w, double e1, double e2);
 /// y = one coordinate of a point uniform on the unit disc (the lens; a cosine-weighted direction
 /// projected onto its tangent plane): 2 J1(|w|) / |w|.
 double discSpectrum(double w);

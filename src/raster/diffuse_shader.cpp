@@ -1,36 +1,11 @@
-// Unshadowed diffuse shading: Lambert's polygon irradiance for each parallelogram light, clipped
-// to the receiver's hemisphere, times the filtered albedo (see diffuse_shader.h).
+// Unshadowed diffuse shading: the lights' closed-form irradiance (scene/light_irradiance.h) times
+// the filtered albedo (see diffuse_shader.h).
 #include "raster/diffuse_shader.h"
 
 #include "raster/checker_texture.h"
+#include "scene/light_irradiance.h"
 
 namespace wedge::raster {
-
-float polygonIrradiance(const scene::ParallelogramLight& light, const Vec3f& p, const Vec3f& n) {
-    if (dot(p - light.corner, light.normal()) <= 0) return 0.f;  // behind the emitting side
-    Vec3f in[4] = {light.corner - p, light.corner + light.edge1 - p, light.corner + light.edge1 + light.edge2 - p,
-                   light.corner + light.edge2 - p};
-    // Sutherland-Hodgman against the receiver's tangent plane dot(n, r) >= 0.
-    Vec3f out[8];
-    int count = 0;
-    for (int k = 0; k < 4; ++k) {
-        const Vec3f& a = in[k];
-        const Vec3f& b = in[(k + 1) % 4];
-        float da = dot(n, a), db = dot(n, b);
-        if (da >= 0) out[count++] = a;
-        if ((da >= 0) != (db >= 0)) out[count++] = a + (b - a) * (da / (da - db));
-    }
-    if (count < 3) return 0.f;
-    float sum = 0;
-    for (int k = 0; k < count; ++k) {
-        Vec3f a = normalize(out[k]), b = normalize(out[(k + 1) % count]);
-        Vec3f c = cross(a, b);
-        float len = length(c);
-        if (len < 1e-12f) continue;
-        sum += std::atan2(len, dot(a, b)) * dot(c, n) / len;
-    }
-    return 0.5f * std::abs(sum);
-}
 
 Vec3f shadeSurface(const RasterScene& scene, const RasterTriangle& tri, const Vec3f& bary, float tau,
                    const Vec3f& footA, const Vec3f& footB) {
@@ -42,9 +17,7 @@ Vec3f shadeSurface(const RasterScene& scene, const RasterTriangle& tri, const Ve
     // Two-sided: shade the side the camera sees.
     if (dot(tri.faceNormalWorld, scene.camera.position() - p) < 0) n = -n;
     Vec3f albedo = texturedAlbedo(m, pRest, tri.faceNormalWorld, footA, footB);
-    Vec3f irradiance(0.f);
-    for (const auto& l : scene.lights) irradiance += l.radiance * polygonIrradiance(l, p, n);
-    return albedo * irradiance * kInvPi;
+    return albedo * scene::unoccludedIrradiance(scene.lights, p, n) * kInvPi;
 }
 
 }  // namespace wedge::raster

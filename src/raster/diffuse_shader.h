@@ -1,4 +1,4 @@
-// The surface shader of the rasterizer: diffuse reflection of the scene's parallelogram lights,
+// The surface shader of the rasterizer: diffuse reflection of the scene's area lights,
 // unshadowed (the pipeline has no visibility queries between surfaces and lights; shadows are out
 // of scope for what it measures, shading cost and cache size), times the textured albedo, plus
 // the material's emission. The irradiance of a uniform polygonal emitter is exact: Lambert's
@@ -10,9 +10,6 @@
 #include "raster/raster_geometry.h"
 
 namespace wedge::raster {
-
-/// Irradiance at p (normal n) from a light of unit radiance, i.e. E / L.
-float polygonIrradiance(const scene::ParallelogramLight& light, const Vec3f& p, const Vec3f& n);
 
 /// Outgoing radiance towards the camera of the point with surface barycentrics `bary` at
 /// normalised shutter time `tau`, textures filtered over the world footprint (footA, footB).

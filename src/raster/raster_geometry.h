@@ -130,7 +130,7 @@ struct RasterScene {
     std::vector<RasterTriangle> triangles;  // what is rasterized: the scene's triangles after splitting
     std::vector<RasterTriangle> parents;    // the scene's triangles before splitting (not rasterized)
     std::vector<scene::Material> materials;
-    std::vector<scene::ParallelogramLight> lights;
+    std::vector<scene::AreaLight> lights;
     size_t culledTriangles = 0;  // degenerate, off screen, or behind the camera for the whole shutter
     bool splitBudgetReached = false;  // kMaxSplitTriangles stopped the split somewhere
 };

@@ -33,6 +33,7 @@ ViewGeometry PathSampler::view() const {
         g.axisB = normalize(cross(g.normal, g.axisA));
         g.edge1 = l.edge1;
         g.edge2 = l.edge2;
+        g.triangle = l.triangle();
         g.sigma = l.sigma();
         g.power = luminance(l.radiance) * l.area();
         v.lights.push_back(g);
@@ -42,10 +43,11 @@ ViewGeometry PathSampler::view() const {
 
 PathSampler::LightSample PathSampler::sampleLight(const Vec3f& p, const Vec3f& n, Vec2f u, float choice) const {
     const auto& lights = m_scene.desc().lights;
-    uint32_t li = 0;
-    while (li + 1 < lights.size() && choice >= m_lightCdf[li]) ++li;
+    // The first light whose cumulative share exceeds `choice` (the last one for rounding's sake).
+    const uint32_t li = uint32_t(std::min<size_t>(
+        std::upper_bound(m_lightCdf.begin(), m_lightCdf.end(), choice) - m_lightCdf.begin(), lights.size() - 1));
     float pChoice = m_lightCdf[li] - (li > 0 ? m_lightCdf[li - 1] : 0.f);
-    const scene::ParallelogramLight& light = lights[li];
+    const scene::AreaLight& light = lights[li];
     LightSample s;
     s.light = li;
     s.point = light.pointAt(u.x, u.y);

@@ -17,11 +17,11 @@ D3 crossd(const D3& a, const D3& b) { return {a.y * b.z - a.z * b.y, a.z * b.x -
 D3 toD(const Vec3f& v) { return {v.x, v.y, v.z}; }
 
 /// Lambert: E / L = (1/2) |sum_i theta_i n . unit(v_i x v_{i+1})| for a polygon above the horizon.
-double polygonFormFactor(const std::vector<D3>& v, const D3& n) {
+double polygonFormFactor(const D3* v, int count, const D3& n) {
     double sum = 0;
-    for (size_t i = 0; i < v.size(); ++i) {
+    for (int i = 0; i < count; ++i) {
         const D3& a = v[i];
-        const D3& b = v[(i + 1) % v.size()];
+        const D3& b = v[(i + 1) % count];
         D3 c = crossd(a, b);
         double cl = std::sqrt(dotd(c, c));
         if (cl <= 0) continue;
@@ -33,24 +33,28 @@ double polygonFormFactor(const std::vector<D3>& v, const D3& n) {
 
 }  // namespace
 
-Vec3f unoccludedIrradiance(const std::vector<ParallelogramLight>& lights, const Vec3f& xf, const Vec3f& nf) {
+Vec3f unoccludedIrradiance(const std::vector<AreaLight>& lights, const Vec3f& xf, const Vec3f& nf) {
     Vec3f total(0.f);
     const D3 x = toD(xf), n = toD(nf);
     for (const auto& l : lights) {
         if (dot(xf - l.corner, l.normal()) <= 0) continue;  // behind the emitting side
-        D3 c = toD(l.corner) - x, e1 = toD(l.edge1), e2 = toD(l.edge2);
-        std::vector<D3> poly = {c, c + e1, c + e1 + e2, c + e2};
-        // Clip to the upper hemisphere n . v >= 0 (Sutherland-Hodgman against one plane).
-        std::vector<D3> clipped;
-        for (size_t i = 0; i < poly.size(); ++i) {
+        Vec3f corners[4];
+        const int count = l.vertices(corners);
+        D3 poly[4];
+        for (int i = 0; i < count; ++i) poly[i] = toD(corners[i]) - x;
+        // Clip to the upper hemisphere n . v >= 0 (Sutherland-Hodgman against one plane): one
+        // vertex more at most.
+        D3 clipped[5];
+        int kept = 0;
+        for (int i = 0; i < count; ++i) {
             const D3& a = poly[i];
-            const D3& b = poly[(i + 1) % poly.size()];
+            const D3& b = poly[(i + 1) % count];
             double da = dotd(n, a), db = dotd(n, b);
-            if (da >= 0) clipped.push_back(a);
-            if ((da >= 0) != (db >= 0)) clipped.push_back(a + (b - a) * (da / (da - db)));
+            if (da >= 0) clipped[kept++] = a;
+            if ((da >= 0) != (db >= 0)) clipped[kept++] = a + (b - a) * (da / (da - db));
         }
-        if (clipped.size() < 3) continue;
-        total += l.radiance * float(polygonFormFactor(clipped, n));
+        if (kept < 3) continue;
+        total += l.radiance * float(polygonFormFactor(clipped, kept, n));
     }
     return total;
 }

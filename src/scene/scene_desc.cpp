@@ -45,6 +45,15 @@ void appendQuad(TriangleMesh& mesh, const Vec3f& corner, const Vec3f& e1, const 
     if (!mesh.cornerNormals.empty()) mesh.cornerNormals.insert(mesh.cornerNormals.end(), 6, normalize(cross(e1, e2)));
 }
 
+void appendTriangle(TriangleMesh& mesh, const Vec3f& corner, const Vec3f& e1, const Vec3f& e2, uint32_t material) {
+    uint32_t base = uint32_t(mesh.positions.size());
+    mesh.positions.insert(mesh.positions.end(), {corner, corner + e1, corner + e2});
+    mesh.indices.insert(mesh.indices.end(), {base, base + 1, base + 2});
+    mesh.materialIds.push_back(material);
+    mesh.shapeIds.push_back(0);
+    if (!mesh.cornerNormals.empty()) mesh.cornerNormals.insert(mesh.cornerNormals.end(), 3, normalize(cross(e1, e2)));
+}
+
 void smoothCornerNormals(TriangleMesh& mesh, float creaseDegrees) {
     const size_t triangles = mesh.triangleCount();
     if (mesh.cornerNormals.empty()) mesh.cornerNormals.assign(3 * triangles, Vec3f(0.f));
@@ -86,16 +95,19 @@ void smoothCornerNormals(TriangleMesh& mesh, float creaseDegrees) {
     }
 }
 
+std::array<std::array<Vec3f, 3>, 6> boxFaces(const Vec3f& lo, const Vec3f& hi) {
+    const Vec3f d = hi - lo;
+    const Vec3f ex(d.x, 0, 0), ey(0, d.y, 0), ez(0, 0, d.z);
+    return {{{lo, ey, ex},         // z = lo (normal -z)
+             {lo + ez, ex, ey},    // z = hi (+z)
+             {lo, ez, ey},         // x = lo (-x)
+             {lo + ex, ey, ez},    // x = hi (+x)
+             {lo, ex, ez},         // y = lo (-y)
+             {lo + ey, ez, ex}}};  // y = hi (+y)
+}
+
 void appendBox(TriangleMesh& mesh, const Vec3f& lo, const Vec3f& hi, uint32_t material) {
-    Vec3f d = hi - lo;
-    Vec3f ex(d.x, 0, 0), ey(0, d.y, 0), ez(0, 0, d.z);
-    // Each face as corner + two edges whose cross product points outward.
-    appendQuad(mesh, lo, ey, ex, material);              // z = lo (normal -z)
-    appendQuad(mesh, lo + ez, ex, ey, material);         // z = hi (+z)
-    appendQuad(mesh, lo, ez, ey, material);              // x = lo (-x)
-    appendQuad(mesh, lo + ex, ey, ez, material);         // x = hi (+x)
-    appendQuad(mesh, lo, ex, ez, material);              // y = lo (-y)
-    appendQuad(mesh, lo + ey, ez, ex, material);         // y = hi (+y)
+    for (const auto& f : boxFaces(lo, hi)) appendQuad(mesh, f[0], f[1], f[2], material);
 }
 
 }  // namespace wedge::scene

@@ -3,6 +3,7 @@
 // so the rasterizer and the tests can use descriptions directly.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -49,17 +50,49 @@ struct CameraDesc {
     float shutterLength() const { return shutterClose - shutterOpen; }
 };
 
-/// A parallelogram area light emitting `radiance` from the side of normalize(cross(edge1, edge2)).
-struct ParallelogramLight {
-    Vec3f corner, edge1, edge2, radiance;
+/// An area light emitting `radiance` from the side of normalize(cross(edge1, edge2)): the
+/// parallelogram corner + a edge1 + b edge2 (a, b in [0, 1]), or the triangle (corner,
+/// corner + edge1, corner + edge2), the parallelogram's half where a + b <= 1.
+struct AreaLight {
+    enum class Shape : uint8_t { Parallelogram, Triangle };
 
+    Vec3f corner, edge1, edge2, radiance;
+    Shape shape = Shape::Parallelogram;
+
+    bool triangle() const { return shape == Shape::Triangle; }
     Vec3f normal() const { return normalize(cross(edge1, edge2)); }
-    float area() const { return length(cross(edge1, edge2)); }
-    Vec3f center() const { return corner + (edge1 + edge2) * 0.5f; }
-    Vec3f pointAt(float u, float v) const { return corner + edge1 * u + edge2 * v; }
+    float area() const { return (triangle() ? 0.5f : 1.f) * length(cross(edge1, edge2)); }
+    /// The centroid.
+    Vec3f center() const { return corner + (edge1 + edge2) * (triangle() ? 1.f / 3.f : 0.5f); }
+    /// Uniform on the light for (u, v) uniform on the unit square: a triangle folds the square's
+    /// half beyond its hypotenuse (u + v > 1) onto its own, which keeps the density uniform and
+    /// the square's stratification.
+    Vec3f pointAt(float u, float v) const {
+        if (triangle() && u + v > 1.f) {
+            u = 1.f - u;
+            v = 1.f - v;
+        }
+        return corner + edge1 * u + edge2 * v;
+    }
+    /// The outline, counter-clockwise seen from the emitting side: 3 or 4 vertices; returns the count.
+    int vertices(Vec3f out[4]) const {
+        out[0] = corner;
+        out[1] = corner + edge1;
+        if (triangle()) {
+            out[2] = corner + edge2;
+            return 3;
+        }
+        out[2] = corner + edge1 + edge2;
+        out[3] = corner + edge2;
+        return 4;
+    }
     /// Standard deviation of the Gaussian the analysis treats the light as (NOTES: sqrt(area)/2).
     float sigma() const { return 0.5f * std::sqrt(area()); }
 };
+
+/// At most this many lights in a scene: MAAF's sample records keep a light's index in a byte,
+/// and every pixel sums the closed-form irradiance of every light.
+constexpr size_t kMaxLights = 256;
 
 /// Triangles in world space at shutter open; `velocity` (world units per unit of shutter time)
 /// moves the whole mesh by velocity x CameraDesc::shutterLength() over the shutter.
@@ -96,7 +129,7 @@ struct SceneDesc {
     std::string file;  // the scene file, for messages
     CameraDesc camera;
     std::vector<Material> materials;
-    std::vector<ParallelogramLight> lights;
+    std::vector<AreaLight> lights;
     std::vector<TriangleMesh> meshes;
     std::vector<Sphere> spheres;
     RenderSettings render;
@@ -118,6 +151,10 @@ void appendQuad(TriangleMesh& mesh, const Vec3f& corner, const Vec3f& e1, const 
 /// corner's own face, so that a scanned surface shades smoothly and a box keeps its edges.
 /// Allocates cornerNormals (zeros) first if it is empty.
 void smoothCornerNormals(TriangleMesh& mesh, float creaseDegrees);
+/// Appends the triangle (corner, corner+e1, corner+e2), wound so that its normal is cross(e1, e2).
+void appendTriangle(TriangleMesh& mesh, const Vec3f& corner, const Vec3f& e1, const Vec3f& e2, uint32_t material);
+/// The six faces of an axis-aligned box as (corner, e1, e2), cross(e1, e2) pointing outward.
+std::array<std::array<Vec3f, 3>, 6> boxFaces(const Vec3f& lo, const Vec3f& hi);
 /// Appends the 12 outward-facing triangles of an axis-aligned box.
 void appendBox(TriangleMesh& mesh, const Vec3f& lo, const Vec3f& hi, uint32_t material);
 

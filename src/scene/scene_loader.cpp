@@ -62,7 +62,7 @@ std::string nameList(const std::vector<std::string>& names) {
 }
 
 /// Accepts a 4-vertex face as a parallelogram light if v2 = v0 + e1 + e2 up to rounding.
-bool asParallelogram(const Vec3f v[4], ParallelogramLight& light) {
+bool asParallelogram(const Vec3f v[4], AreaLight& light) {
     Vec3f e1 = v[1] - v[0], e2 = v[3] - v[0];
     float scale = std::max(length(e1), length(e2));
     if (scale <= 0 || length(cross(e1, e2)) <= 1e-8f * scale * scale) return false;
@@ -109,7 +109,7 @@ public:
         if (auto r = root.optional("render")) parseRender(*r);
         root.finish();
         if (m_desc.lights.empty())
-            throw Error(m_file + ": lights", "the scene has no light (add a parallelogram light)");
+            throw Error(m_file + ": lights", "the scene has no light (add a parallelogram or triangle light, or an emissive surface)");
         if (m_desc.meshes.empty() && m_desc.spheres.empty()) throw Error(m_file + ": objects", "the scene has no geometry");
         return std::move(m_desc);
     }
@@ -175,15 +175,19 @@ private:
         for (size_t i = 0; i < lights.size(); ++i) {
             JsonNode l = lights[i];
             std::string type = l["type"].string();
-            if (type != "parallelogram") l["type"].fail("unknown light type '" + type + "' (expected \"parallelogram\")");
-            ParallelogramLight light;
+            AreaLight light;
+            if (type == "triangle") light.shape = AreaLight::Shape::Triangle;
+            else if (type != "parallelogram")
+                l["type"].fail("unknown light type '" + type + "' (expected \"parallelogram\" or \"triangle\")");
             light.corner = l["corner"].vec3();
             light.edge1 = l["edge1"].vec3();
             light.edge2 = l["edge2"].vec3();
             light.radiance = l["radiance"].color();
             if (light.area() <= 0) l["edge2"].fail("edge1 and edge2 span no area");
-            checkExtent(l, {light.corner, light.corner + light.edge1, light.corner + light.edge2,
-                            light.corner + light.edge1 + light.edge2});
+            Vec3f corners[4];
+            checkExtent(l, std::vector<Vec3f>(corners, corners + light.vertices(corners)));
+            if (m_desc.lights.size() == kMaxLights)
+                l.fail("more than " + std::to_string(kMaxLights) + " lights (MAAF keeps a light's index in a byte)");
             l.finish();
             m_desc.lights.push_back(light);
             // The light is visible to the camera as an emitter of its own (albedo 0).
@@ -195,7 +199,8 @@ private:
             m_desc.materials.push_back(mat);
             TriangleMesh mesh;
             mesh.name = mat.name;
-            appendQuad(mesh, light.corner, light.edge1, light.edge2, id);
+            if (light.triangle()) appendTriangle(mesh, light.corner, light.edge1, light.edge2, id);
+            else appendQuad(mesh, light.corner, light.edge1, light.edge2, id);
             m_desc.meshes.push_back(std::move(mesh));
         }
     }
@@ -222,21 +227,22 @@ private:
                 if (length(cross(e1, e2)) <= 0) o["edge2"].fail("edge1 and edge2 span no area");
                 uint32_t mat = material(o["material"]);
                 appendQuad(mesh, corner, e1, e2, mat);
-                promoteIfEmissive(mat, corner, e1, e2, mesh.velocity);
-                if (mesh.velocity != Vec3f(0.f)) warnIfUnlit(o, mat, "a moving quad");
+                promoteIfEmissive(o, mat, {{corner, e1, e2, m_desc.materials[mat].emission}}, mesh.velocity, "this quad");
             } else if (type == "box") {
                 Vec3f lo = o["min"].vec3(), hi = o["max"].vec3();
                 if (!(hi.x > lo.x && hi.y > lo.y && hi.z > lo.z)) o["max"].fail("expected max > min in every axis");
                 const uint32_t mat = material(o["material"]);
                 appendBox(mesh, lo, hi, mat);
-                warnIfUnlit(o, mat, "a box");
+                std::vector<AreaLight> faces;
+                for (const auto& f : boxFaces(lo, hi)) faces.push_back({f[0], f[1], f[2], m_desc.materials[mat].emission});
+                promoteIfEmissive(o, mat, faces, mesh.velocity, "this box");
             } else if (type == "sphere") {
                 Sphere s;
                 s.center = o["center"].vec3();
                 s.radius = float(o["radius"].positive());
                 s.material = material(o["material"]);
                 s.velocity = mesh.velocity;
-                warnIfUnlit(o, s.material, "a sphere");
+                warnIfUnlitSphere(o, s.material);
                 checkExtent(o, {s.center - Vec3f(s.radius), s.center + Vec3f(s.radius)}, s.velocity);
                 o.finish();
                 m_desc.spheres.push_back(s);
@@ -266,37 +272,48 @@ private:
             xf.axis = normalize(axis);
             xf.radians = float((*r)[3].number()) * kDegToRad;
         }
-        std::vector<ParallelogramLight> promoted;
+        std::vector<AreaLight> promoted;
         loadObj(p.string(), fileNode.where(), overrideMaterial, m_desc.materials, mesh, promoted, m_desc.warnings);
         for (auto& v : mesh.positions) v = xf.apply(v);
         for (auto& n : mesh.cornerNormals) n = xf.applyNormal(n);
-        if (!promoted.empty() && mesh.velocity != Vec3f(0.f))
-            m_desc.warnings.push_back(o.where() + ": " + std::to_string(promoted.size()) +
-                                      " emissive parallelogram face(s) of a moving mesh are only seen: they light nothing");
         for (auto& l : promoted) {
             Vec3f c0 = xf.apply(l.corner);
             l.edge1 = xf.apply(l.corner + l.edge1) - c0;
             l.edge2 = xf.apply(l.corner + l.edge2) - c0;
             l.corner = c0;
-            if (mesh.velocity == Vec3f(0.f)) m_desc.lights.push_back(l);
         }
+        addLights(o, promoted, mesh.velocity, "'" + fileNode.string() + "'");
     }
 
-    /// Light comes from the scene's parallelogram lights and from the emissive quads and OBJ
-    /// parallelogram faces that do not move, which become such lights; other emitters are seen
-    /// (their emission is in the image where the camera sees them) but light nothing. Say so.
-    void warnIfUnlit(const JsonNode& o, uint32_t mat, const char* what) {
+    /// Light comes from the scene's lights and from the emitters that do not move: quads, boxes'
+    /// faces and OBJ faces become lights. Spheres are seen (their emission is in the image where
+    /// the camera sees them) but light nothing. Say so.
+    void warnIfUnlitSphere(const JsonNode& o, uint32_t mat) {
         const Material& m = m_desc.materials[mat];
-        if (!m.isEmitter()) return;
-        m_desc.warnings.push_back(o.where() + ": material '" + m.name + "' emits, but " + what +
-                                  " is only seen: it lights nothing (lights are the scene's parallelograms and the "
-                                  "emissive quads and OBJ parallelogram faces that do not move)");
+        if (m.isEmitter())
+            m_desc.warnings.push_back(o.where() + ": material '" + m.name +
+                                      "' emits, but a sphere is only seen: it lights nothing (spheres are not lights)");
     }
 
-    void promoteIfEmissive(uint32_t mat, const Vec3f& corner, const Vec3f& e1, const Vec3f& e2, const Vec3f& velocity) {
-        const Material& m = m_desc.materials[mat];
-        if (!m.isEmitter() || velocity != Vec3f(0.f)) return;  // moving emitters stay visible-only
-        m_desc.lights.push_back({corner, e1, e2, m.emission});
+    /// Adds an object's emissive faces (those of `owner`) as lights: all of them, or none where
+    /// the object moves or they would take the scene past kMaxLights.
+    void addLights(const JsonNode& o, const std::vector<AreaLight>& faces, const Vec3f& velocity, const std::string& owner) {
+        if (faces.empty()) return;
+        std::string why;
+        if (velocity != Vec3f(0.f)) why = "moving emitters are not lights";
+        else if (m_desc.lights.size() + faces.size() > kMaxLights)
+            why = "the scene has " + std::to_string(m_desc.lights.size()) + " lights before them and takes " +
+                  std::to_string(kMaxLights) + " at most";
+        if (why.empty()) m_desc.lights.insert(m_desc.lights.end(), faces.begin(), faces.end());
+        else
+            m_desc.warnings.push_back(o.where() + ": the " + std::to_string(faces.size()) + " emissive face(s) of " + owner +
+                                      " are only seen and light nothing: " + why);
+    }
+
+    /// `faces` of material `mat` as lights, if it emits.
+    void promoteIfEmissive(const JsonNode& o, uint32_t mat, const std::vector<AreaLight>& faces, const Vec3f& velocity,
+                           const std::string& owner) {
+        if (m_desc.materials[mat].isEmitter()) addLights(o, faces, velocity, owner);
     }
 
     /// Every point, at the shutter's open and close (moved by velocity x (close - open)), within
@@ -475,7 +492,7 @@ std::vector<uint32_t> appendMtlMaterials(const std::string& path, const std::str
 }  // namespace
 
 void loadObj(const std::string& path, const std::string& where, int overrideMaterial, std::vector<Material>& materials,
-             TriangleMesh& mesh, std::vector<ParallelogramLight>& promoted, std::vector<std::string>& warnings) {
+             TriangleMesh& mesh, std::vector<AreaLight>& promoted, std::vector<std::string>& warnings) {
     if (!fs::is_regular_file(path)) throw Error(where, "mesh file '" + path + "' does not exist");
     tinyobj::ObjReader reader;
     std::vector<MtlColours> mtlColours;
@@ -554,7 +571,7 @@ void loadObj(const std::string& path, const std::string& where, int overrideMate
             if (n < 3) continue;
             if (materials[matId].isEmitter()) {
                 Vec3f v[4];
-                ParallelogramLight light;
+                AreaLight light;
                 if (n == 4) for (int k = 0; k < 4; ++k) v[k] = mesh.positions[idx[k]];
                 if (n == 4 && asParallelogram(v, light)) {
                     light.radiance = materials[matId].emission;
@@ -583,9 +600,8 @@ void loadObj(const std::string& path, const std::string& where, int overrideMate
                                " is not rendered: the file has no texture coordinates (vt)");
     }
     // An exporter that triangulates splits a rectangular light into two triangles along a
-    // diagonal: pair such triangles back into parallelogram lights. The rest are seen only.
-    size_t unlitFaces = 0;
-    std::vector<std::string> unlitMaterials;
+    // diagonal: pair such triangles back into parallelogram lights (one light where there would
+    // be two, sampled as one). The rest are triangle lights.
     std::vector<bool> paired(emissiveTriangles.size(), false);
     // A triangle's candidates are those sharing an edge with it, found by edge instead of by
     // comparing every pair (an emissive mesh of 69K triangles would take 2.4e9 comparisons).
@@ -618,7 +634,7 @@ void loadObj(const std::string& path, const std::string& where, int overrideMate
                 }
                 if (shared != 2 || d < 0) continue;
                 const Vec3f q[4] = {mesh.positions[s1], mesh.positions[off], mesh.positions[s2], mesh.positions[uint32_t(d)]};
-                ParallelogramLight light;
+                AreaLight light;
                 if (asParallelogram(q, light)) {
                     light.radiance = materials[t.material].emission;
                     promoted.push_back(light);
@@ -627,16 +643,11 @@ void loadObj(const std::string& path, const std::string& where, int overrideMate
             }
         }
         if (!paired[a]) {
-            ++unlitFaces;
-            if (std::find(unlitMaterials.begin(), unlitMaterials.end(), materials[t.material].name) == unlitMaterials.end())
-                unlitMaterials.push_back(materials[t.material].name);
+            const Vec3f p0 = mesh.positions[t.v[0]];
+            AreaLight light{p0, mesh.positions[t.v[1]] - p0, mesh.positions[t.v[2]] - p0, materials[t.material].emission,
+                            AreaLight::Shape::Triangle};
+            if (light.area() > 0) promoted.push_back(light);  // a degenerate face emits nothing
         }
-    }
-    if (unlitFaces > 0) {
-        warnings.push_back(where + ": '" + path + "': " + std::to_string(unlitFaces) + " emissive triangle(s) of " +
-                           nameList(unlitMaterials) +
-                           " form no parallelogram: they are only seen and light nothing (only parallelogram faces, or "
-                           "two triangles that make one, become lights)");
     }
     // Corners without a `vn` (a scanned mesh has none) shade smoothly across edges under
     // kCreaseDegrees: per-triangle normals of a fine scan differ by tens of degrees between

@@ -24,10 +24,11 @@ std::string scenesDirectory();
 
 /// Loads a Wavefront OBJ (with its MTL) into `mesh`, appending its materials to `materials`
 /// unless `overrideMaterial` >= 0. The text is checked line by line first (obj_check.h).
-/// Emissive parallelogram faces, and pairs of emissive triangles that make one, become lights in
-/// `promoted`. What wedge does not render (specular terms, transparency, maps it cannot read,
-/// emissive triangles left over, lines that are no OBJ statement) is named in `warnings`.
+/// Emissive faces become lights in `promoted`: parallelogram faces, and pairs of triangles that
+/// make one, as parallelograms; the rest as triangles (a polygon by its fan). What wedge does not
+/// render (specular terms, transparency, maps it cannot read, lines that are no OBJ statement)
+/// is named in `warnings`.
 void loadObj(const std::string& path, const std::string& where, int overrideMaterial, std::vector<Material>& materials,
-             TriangleMesh& mesh, std::vector<ParallelogramLight>& promoted, std::vector<std::string>& warnings);
+             TriangleMesh& mesh, std::vector<AreaLight>& promoted, std::vector<std::string>& warnings);
 
 }  // namespace wedge::scene
