@@ -194,6 +194,45 @@ TEST(WedgeField, PrefilterKeepsWellSampledSlopesAndWidensTheRest) {
     }
 }
 
+TEST(WedgeField, TheLightSizeIsTakenWithTheSlopes) {
+    // Two lights: pixel (2, 2) is in the shadow of the large one (sigma 0.4), pixel (6, 2) of
+    // the small one (0.05). The light size travels with the slopes: own where the slopes are
+    // own, the window's smallest where they come from the window, the fill's where they are
+    // filled; +inf without a wedge.
+    Plane pl(13, 5);
+    FrameBuffers& fb = pl.fb;
+    for (size_t i = 0; i < fb.sMin.size(); ++i) {
+        fb.sMin[i] = fb.lightSigma[i] = fb.zMin[i] = fb.zMax[i] = kInf;
+        fb.sMax[i] = fb.occluded[i] = 0;
+    }
+    fb.sMin(2, 2) = 1.f, fb.sMax(2, 2) = 2.f, fb.lightSigma(2, 2) = 0.4f, fb.occluded(2, 2) = 1.f;
+    fb.sMin(6, 2) = 3.f, fb.sMax(6, 2) = 4.f, fb.lightSigma(6, 2) = 0.05f, fb.occluded(6, 2) = 0.2f;
+    WedgeOptions maaf;  // 5x5 max / min, own slopes from half the rays occluded, filled over 5 px
+    maaf.ownShadowOccluded = 0.5f;
+    maaf.fillRadius = 5;
+    WedgeField w = prefilterWedges(fb, maaf);
+    EXPECT_FLOAT_EQ(w.lightSigma(2, 2), 0.4f) << "own slopes, own light";
+    EXPECT_FLOAT_EQ(w.lightSigma(6, 2), 0.05f);
+    EXPECT_FLOAT_EQ(w.lightSigma(1, 2), 0.4f) << "only the large light's shadow in the window";
+    EXPECT_FLOAT_EQ(w.lightSigma(4, 2), 0.05f) << "both in the window: the smaller";
+    EXPECT_FLOAT_EQ(w.s2(4, 2), 1.f);
+    EXPECT_FLOAT_EQ(w.lightSigma(11, 2), 0.05f) << "filled from (6, 2)'s window";
+    EXPECT_FLOAT_EQ(w.s2(11, 2), 3.f);
+    WedgeOptions aaf;  // 11x11 fill only
+    aaf.radius = 5;
+    aaf.fillOnly = true;
+    WedgeField a = prefilterWedges(fb, aaf);
+    EXPECT_FLOAT_EQ(a.lightSigma(6, 2), 0.05f);
+    EXPECT_FLOAT_EQ(a.lightSigma(0, 0), 0.4f) << "(6, 2) is beyond its window";
+    EXPECT_FLOAT_EQ(a.lightSigma(3, 0), 0.05f);
+    WedgeOptions narrow;  // 3x3, no fill: pixels far from both shadows have no wedge
+    narrow.radius = 1;
+    WedgeField n = prefilterWedges(fb, narrow);
+    EXPECT_FLOAT_EQ(n.lightSigma(1, 1), 0.4f);
+    EXPECT_GE(n.lightSigma(4, 0), kInf);
+    EXPECT_GE(n.s2(4, 0), kInf);
+}
+
 TEST(WedgeField, PrefilterKeepsOwnBounceDistancesWhereMostBouncesHit) {
     // A 9x9 plane whose pixels' bounces hit at [2, 5], except (5, 4), whose hit a fixture at
     // [0.05, 5]; pixel (4, 4)'s own are [1, 3]. It keeps them when, on average over its 5x5

@@ -8,7 +8,7 @@ FrameBuffers::FrameBuffers(int w, int h)
     : width(w), height(h), color(w, h), emission(w, h), direct(w, h), indirect(w, h), albedo(w, h), normal(w, h),
       position(w, h), rest(w, h), depth(w, h), spp(w, h), object(w, h), coverage(w, h), variance(w, h),
       directUnoccluded(w, h), visibility(w, h), unoccluded(w, h), d1(w, h), sMax(w, h), sMin(w, h),
-      occluded(w, h), zMin(w, h), zMax(w, h), bounced(w, h), suMin(w, h), suMax(w, h), defocus(w, h), footprint(w, h) {
+      occluded(w, h), lightSigma(w, h), zMin(w, h), zMax(w, h), bounced(w, h), suMin(w, h), suMax(w, h), defocus(w, h), footprint(w, h) {
     for (OtherSurface& o : other) {
         // Each constructed, not copied: a copy is another pass over fresh pages.
         for (Image3f* plane : {&o.albedo, &o.normal, &o.position, &o.direct, &o.indirect}) *plane = Image3f(w, h);
@@ -45,6 +45,7 @@ void FrameBuffers::forEachPlane(const std::function<void(const std::string&, int
     v1("slope.s1", sMax);
     v1("slope.s2", sMin);
     v1("slope.occluded", occluded);
+    v1("slope.sigma", lightSigma);
     v1("slope.zmin", zMin);
     v1("slope.zmax", zMax);
     v1("slope.bounced", bounced);

@@ -94,6 +94,8 @@ struct FrameBuffers {
     Image1f d1;            // mean distance receiver -> light centre over occluded shadow rays
     Image1f sMax, sMin;    // shadow slopes s1 = max d1/d2min - 1, s2 = min d1/d2max - 1; 0/inf when unoccluded
     Image1f occluded;      // fraction of shadow rays that hit an occluder
+    Image1f lightSigma;    // the smallest Gaussian model (sigma) among the lights of the occluded
+                           // shadow rays: the size of the light that casts the pixel's shadow; inf where none
     Image1f zMin, zMax;    // bounce distances
     Image1f bounced;       // fraction of the initial samples whose bounce ray hit a surface
     Image1f suMin, suMax;  // defocus slopes, pixels per unit lens coordinate

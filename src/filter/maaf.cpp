@@ -179,7 +179,7 @@ MaafParams maafParams(const FrameBuffers& fb, const WedgeField& wf, const Filter
         in.fallback = in.fallback || !oneLight;
         in.step = frames.direct[p].step[k];
         in.yWedge = wf.s2[p] < kInf;
-        in.omegaY = o.mu / sigma;
+        in.omegaY = o.mu / (wf.lightSigma[p] < kInf ? wf.lightSigma[p] : sigma);  // wedge_field.h
         in.sMin = std::max(wf.s2[p], 1e-4f);
         in.sMax = std::max(wf.s1[p], wf.s2[p]);
         in.suMin = wf.suMin[p] * in.step;

@@ -6,11 +6,12 @@ namespace wedge::filter {
 
 WedgeField prefilterWedges(const FrameBuffers& fb, const WedgeOptions& o) {
     const int W = fb.width, H = fb.height;
-    WedgeField wf{Image1f(W, H), Image1f(W, H), Image1f(W, H), Image1f(W, H), Image1f(W, H), Image1f(W, H), Image1f(W, H)};
+    WedgeField wf{Image1f(W, H), Image1f(W, H), Image1f(W, H), Image1f(W, H),
+                  Image1f(W, H), Image1f(W, H), Image1f(W, H), Image1f(W, H)};
     parallelRows(H, [&](int y) {
         for (int x = 0; x < W; ++x) {
             size_t p = size_t(y) * W + x;
-            float s1 = 0, s2 = kInf, zMin = kInf, zMax = 0, suMin = kInf, suMax = -kInf;
+            float s1 = 0, s2 = kInf, sigma = kInf, zMin = kInf, zMax = 0, suMin = kInf, suMax = -kInf;
             bool ownShadow = fb.sMin[p] < kInf, ownBounce = fb.zMin[p] < kInf;
             const bool keepShadow = ownShadow && (o.fillOnly || fb.occluded[p] >= o.ownShadowOccluded);
             float hitSum = 0;  // fractions of bounce rays that hit, summed over the window's surface
@@ -27,6 +28,7 @@ WedgeField prefilterWedges(const FrameBuffers& fb, const WedgeOptions& o) {
                     if (!keepShadow && fb.sMin[q] < kInf) {
                         s1 = std::max(s1, fb.sMax[q]);
                         s2 = std::min(s2, fb.sMin[q]);
+                        sigma = std::min(sigma, fb.lightSigma[q]);
                     }
                     if (fb.zMin[q] < kInf) {
                         zMin = std::min(zMin, fb.zMin[q]);
@@ -38,13 +40,14 @@ WedgeField prefilterWedges(const FrameBuffers& fb, const WedgeOptions& o) {
                     suMax = std::max(suMax, fb.suMax[q]);
                 }
             }
-            if (keepShadow) { s1 = fb.sMax[p]; s2 = fb.sMin[p]; }
+            if (keepShadow) { s1 = fb.sMax[p]; s2 = fb.sMin[p]; sigma = fb.lightSigma[p]; }
             // The neighbourhood's hit fraction, not the pixel's own, decides: neighbouring pixels
             // then decide alike, and filter widths do not alternate from pixel to pixel.
             const bool keepBounce = ownBounce && (o.fillOnly || hitSum >= o.ownBounceHit * float(hitCount));
             if (keepBounce) { zMin = fb.zMin[p]; zMax = fb.zMax[p]; }
             wf.s1[p] = s1;
             wf.s2[p] = s2;
+            wf.lightSigma[p] = sigma;
             wf.zMin[p] = zMin;
             wf.zMax[p] = zMax;
             wf.suMin[p] = suMin <= suMax ? suMin : 0.f;
@@ -58,14 +61,14 @@ WedgeField prefilterWedges(const FrameBuffers& fb, const WedgeOptions& o) {
         // Separable: along rows, then along columns of the row results. Each pass compares a
         // neighbour's surface with the pixel the pass is centred on.
         struct Fill {
-            float s1, s2, z1, z2;
+            float s1, s2, sigma, z1, z2;
         };
         Image<Fill> row(W, H), col(W, H);
         auto pass = [&](const Image<Fill>& src, Image<Fill>& dst, bool vertical) {
             parallelRows(H, [&](int y) {
                 for (int x = 0; x < W; ++x) {
                     size_t p = size_t(y) * W + x;
-                    Fill f{0, kInf, kInf, 0};
+                    Fill f{0, kInf, kInf, kInf, 0};
                     if (fb.object[p] >= 0)
                         for (int k = -o.fillRadius; k <= o.fillRadius; ++k) {
                             int xx = vertical ? x : x + k, yy = vertical ? y + k : y;
@@ -73,7 +76,11 @@ WedgeField prefilterWedges(const FrameBuffers& fb, const WedgeOptions& o) {
                             size_t q = size_t(yy) * W + xx;
                             if (!sameSurface(fb, p, q, o.normalCos)) continue;
                             const Fill& g = src[q];
-                            if (g.s2 < kInf) { f.s1 = std::max(f.s1, g.s1); f.s2 = std::min(f.s2, g.s2); }
+                            if (g.s2 < kInf) {
+                                f.s1 = std::max(f.s1, g.s1);
+                                f.s2 = std::min(f.s2, g.s2);
+                                f.sigma = std::min(f.sigma, g.sigma);
+                            }
                             if (g.z1 < kInf) { f.z1 = std::min(f.z1, g.z1); f.z2 = std::max(f.z2, g.z2); }
                         }
                     dst[p] = f;
@@ -81,14 +88,14 @@ WedgeField prefilterWedges(const FrameBuffers& fb, const WedgeOptions& o) {
             });
         };
         Image<Fill> own(W, H);
-        for (size_t p = 0; p < own.size(); ++p) own[p] = {wf.s1[p], wf.s2[p], wf.zMin[p], wf.zMax[p]};
+        for (size_t p = 0; p < own.size(); ++p) own[p] = {wf.s1[p], wf.s2[p], wf.lightSigma[p], wf.zMin[p], wf.zMax[p]};
         pass(own, row, false);
         pass(row, col, true);
         parallelRows(H, [&](int y) {
             for (int x = 0; x < W; ++x) {
                 size_t p = size_t(y) * W + x;
                 if (fb.object[p] < 0) continue;
-                if (wf.s2[p] >= kInf) { wf.s1[p] = col[p].s1; wf.s2[p] = col[p].s2; }
+                if (wf.s2[p] >= kInf) { wf.s1[p] = col[p].s1; wf.s2[p] = col[p].s2; wf.lightSigma[p] = col[p].sigma; }
                 if (wf.zMin[p] >= kInf) { wf.zMin[p] = col[p].z1; wf.zMax[p] = col[p].z1 < kInf ? col[p].z2 : 0.f; }
             }
         });

@@ -7,6 +7,9 @@
 // the same surface (same object, normals within 20 degrees). That is robust where few of a
 // pixel's 16 samples saw an occluder (NOTES: MAAF reimplementation, 5x5 window) and it fills
 // pixels whose samples saw none from their neighbours (NOTES: AAF 2012 code, 10 px window).
+// With several lights, the light whose shadow a pixel is in sets its wedge's light size, the
+// smallest among those its occluded shadow rays (or its neighbours') aimed at: the visibility of
+// an unoccluded light is constant and adds no bandwidth.
 #pragma once
 
 #include "core/buffers.h"
@@ -15,6 +18,8 @@ namespace wedge::filter {
 
 struct WedgeField {
     Image1f s1, s2;        // shadow slope bounds; s2 = +inf where no occluder was seen in the window
+    Image1f lightSigma;    // the size (Gaussian sigma) of the smallest light whose shadow the window
+                           // saw, taken with s1 and s2; +inf where s2 is
     Image1f zMin, zMax;    // bounce distances; +inf where no bounce hit
     Image1f suMin, suMax;  // defocus slopes (pixels per unit lens coordinate)
     Image1f focalStraddle; // 1 where defocus slopes within `focalRadius` take both signs (focal plane)

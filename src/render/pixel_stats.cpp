@@ -36,6 +36,7 @@ void SurfaceSlot::add(const TracedSample& s, const ViewGeometry& view, bool slop
             float d2max = std::max(s.d1 - s.tNear, 1e-3f * s.d1);
             s1 = std::max(s1, s.d1 / d2min - 1.f);
             s2 = std::min(s2, s.d1 / d2max - 1.f);
+            lightSigma = std::min(lightSigma, view.lights[r.light].sigma);
         }
     }
     if (s.bounceHit) {
@@ -131,7 +132,7 @@ void PixelStats::store(FrameBuffers& fb, int x, int y, const ViewGeometry& view)
     if (m.n == 0) {  // nothing hit: background
         fb.depth[p] = fb.footprint[p] = fb.visibility[p] = fb.unoccluded[p] = 0;
         fb.d1[p] = fb.sMax[p] = fb.occluded[p] = fb.bounced[p] = fb.suMin[p] = fb.suMax[p] = 0;
-        fb.sMin[p] = fb.zMin[p] = fb.zMax[p] = kInf;
+        fb.sMin[p] = fb.zMin[p] = fb.zMax[p] = fb.lightSigma[p] = kInf;
         return;
     }
     const float invM = 1.f / float(m.n);
@@ -142,6 +143,7 @@ void PixelStats::store(FrameBuffers& fb, int x, int y, const ViewGeometry& view)
     fb.d1[p] = m.nOccluded > 0 ? m.d1Sum / float(m.nOccluded) : 0.f;
     fb.sMax[p] = m.nOccluded > 0 ? m.s1 : 0.f;
     fb.sMin[p] = m.nOccluded > 0 ? m.s2 : kInf;
+    fb.lightSigma[p] = m.lightSigma;
     fb.occluded[p] = m.nShadow > 0 ? float(m.nOccluded) / float(m.nShadow) : 0.f;
     fb.zMin[p] = m.nBounce > 0 ? m.zMin : kInf;
     fb.zMax[p] = m.nBounce > 0 ? m.zMax : kInf;

@@ -40,6 +40,7 @@ struct SurfaceSlot {
     float d1Sum = 0;
     uint32_t nSlopes = 0, nShadow = 0, nOccluded = 0, nBounce = 0;
     float s1 = 0, s2 = kInf;            // max d1/d2min - 1, min d1/d2max - 1
+    float lightSigma = kInf;            // smallest ViewGeometry::Light::sigma of the occluded samples' lights
     float zMin = kInf, zMax = 0;        // bounce hit distances
     float suMin = kInf, suMax = -kInf;  // defocus slopes
 
