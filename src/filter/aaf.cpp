@@ -7,8 +7,6 @@ namespace wedge::filter {
 AafParams aafParams(const FrameBuffers& fb, const WedgeField& wf, const ViewGeometry& view, const AafOptions& o) {
     const int W = fb.width, H = fb.height;
     AafParams ap{Image1f(W, H), Image1f(W, H), Image1f(W, H), Image1f(W, H), Image1f(W, H)};
-    float smallest = kInf;  // the smallest light, where a pixel has no light size of its own
-    for (auto& l : view.lights) smallest = std::min(smallest, l.sigma);
     const bool lens = view.apertureRadius > 0;
     parallelRows(H, [&](int y) {
         for (int x = 0; x < W; ++x) {
@@ -25,8 +23,9 @@ AafParams aafParams(const FrameBuffers& fb, const WedgeField& wf, const ViewGeom
             // Soft shadows (NOTES: Omega = min(mu / (sigma s2), 1 / (d (1 + s2)))).
             float s1 = wf.s1[p], s2 = wf.s2[p];
             bool shadow = s2 < kInf;
-            // The light whose shadow this is (wedge_field.h): the smallest of several, if any.
-            const float sigma = wf.lightSigma[p] < kInf ? wf.lightSigma[p] : smallest;
+            // The light whose shadow this is (wedge_field.h: the smallest of several; finite
+            // wherever s2 is).
+            const float sigma = wf.lightSigma[p];
             float omegaShadow = shadow ? std::min(o.mu / (sigma * std::max(s2, 1e-6f)), 1.f / (d * (1.f + s2))) : 0.f;
             float omegaD = std::min({omegaPix, omegaShadow, omegaLens});
             ap.omegaDirect[p] = omegaD;
