@@ -690,6 +690,57 @@ TEST(MaafWeights, TriangleSpectrumIsTheTrianglesCharacteristicFunction) {
     EXPECT_NEAR(triangleSpectrum(1e-6, 0.3, 0.9), triangleSpectrum(2e-4, 0.3, 0.9), 1e-7);
 }
 
+TEST(MaafWeights, ALightsPartsSumToItsSpectrum) {
+    // A light made of parts (a group of lights, ViewGeometry::Light): the area-weighted sum of
+    // the parts' characteristic functions about the whole light's centroid. A parallelogram
+    // (edges projecting to e1, e2) as the fan of its four triangles about its centre, and as its
+    // two halves, gives its own spectrum; an off-centre triangle matches numerical integration.
+    for (auto [e1, e2] : {std::pair{0.8, 0.3}, {-0.5, 0.9}, {0.0, 1.2}})
+        for (double w : {0.0, 1e-5, 0.5, 2.0, 5.0, 11.0}) {
+            const double whole = parallelogramSpectrum(w, e1, e2);
+            const double c[4] = {-0.5 * (e1 + e2), 0.5 * (e1 - e2), 0.5 * (e1 + e2), 0.5 * (e2 - e1)};  // corners from the centre
+            double fan = 0;
+            for (int i = 0; i < 4; ++i) fan += 0.25 * triangleSpectrumAt(w, 0.0, c[i], c[(i + 1) % 4]);
+            const double halves = 0.5 * triangleSpectrumAt(w, c[0], c[1], c[3]) + 0.5 * triangleSpectrumAt(w, c[2], c[3], c[1]);
+            EXPECT_NEAR(fan, whole, 1e-9) << e1 << " " << e2 << " w = " << w;
+            EXPECT_NEAR(halves, whole, 1e-9) << e1 << " " << e2 << " w = " << w;
+        }
+    // E[cos(w y)] over the triangle (x0, x1, x2) = (0.7, 1.1, 0.2), by the midpoint rule.
+    const double x0 = 0.7, x1 = 1.1, x2 = 0.2;
+    for (double w : {0.3, 2.0, 7.0}) {
+        const int n = 400;
+        double sum = 0;
+        for (int i = 0; i < n; ++i)
+            for (int j = 0; i + j < n; ++j) {
+                auto at = [&](double a, double b) { return x0 + (x1 - x0) * a / n + (x2 - x0) * b / n; };
+                sum += std::cos(w * at(i + 1.0 / 3, j + 1.0 / 3));
+                if (i + j < n - 1) sum += std::cos(w * at(i + 2.0 / 3, j + 2.0 / 3));
+            }
+        EXPECT_NEAR(triangleSpectrumAt(w, x0, x1, x2), sum / (double(n) * n), 1e-4) << "w = " << w;
+    }
+    EXPECT_NEAR(triangleSpectrumAt(1e-6, 3.0, 3.2, 3.1), std::cos(1e-6 * 3.1), 1e-12);  // a thin, far part: its series branch
+}
+
+TEST(MaafWeights, AGroupOfLightsHasTheWholeLightsSpectrum) {
+    // A 0.8 x 0.6 parallelogram light as one part, as the fan of four triangles about its
+    // centre, and as two parallelograms side by side (whose offsets from the centroid enter
+    // through e^{iwd}): the same spectrum along any axis.
+    const Vec3f corner(0.1f, 2.f, -0.3f), e1(0.8f, 0.f, 0.f), e2(0.f, 0.f, 0.6f);
+    ViewGeometry::Light whole, fan, halves;
+    whole.center = fan.center = halves.center = corner + (e1 + e2) * 0.5f;
+    whole.parts = {{corner, e1, e2, false, 1.f}};
+    const Vec3f c[4] = {corner, corner + e1, corner + e1 + e2, corner + e2};
+    for (int i = 0; i < 4; ++i) fan.parts.push_back({whole.center, c[i] - whole.center, c[(i + 1) % 4] - whole.center, true, 0.25f});
+    halves.parts = {{corner, e1 * 0.5f, e2, false, 0.5f}, {corner + e1 * 0.5f, e1 * 0.5f, e2, false, 0.5f}};
+    for (const Vec3f& axis : {Vec3f(1, 0, 0), normalize(Vec3f(0.6f, 0.2f, 0.7f)), normalize(Vec3f(-0.3f, 0.9f, 0.2f))})
+        for (double w : {0.0, 1.0, 4.0, 9.0, 20.0}) {
+            const double expected = lightSpectrum(w, whole, axis);
+            EXPECT_NEAR(expected, parallelogramSpectrum(w, dot(e1, axis), dot(e2, axis)), 1e-6);
+            EXPECT_NEAR(lightSpectrum(w, fan, axis), expected, 1e-6) << "w = " << w;
+            EXPECT_NEAR(lightSpectrum(w, halves, axis), expected, 1e-6) << "w = " << w;
+        }
+}
+
 namespace {
 /// RMS bias of the expected MAAF output across a flatland penumbra under a strip light 1 long
 /// and 1 / aspect wide, seen along its length (analysis/penumbra.h: the renderer's kernel, samples

@@ -327,6 +327,52 @@ TEST(Render, ImageIsBitIdenticalOnOneAndTwoThreads) {
     }
 }
 
+TEST(Render, ALampOfTrianglesIsOneLightForTheFilters) {
+    // kPlaneScene's light as the fan of four triangles about its centre: the filters see one
+    // light (ViewGeometry::lights), with the whole light's centroid, size and parts, and every
+    // sample's record names it; the image is the parallelogram's.
+    const std::string fan = R"("lights": [
+      {"type": "triangle", "corner": [0.2, 1, 0], "edge1": [-0.5, 0, -0.5], "edge2": [0.5, 0, -0.5], "radiance": [10, 10, 10]},
+      {"type": "triangle", "corner": [0.2, 1, 0], "edge1": [0.5, 0, -0.5], "edge2": [0.5, 0, 0.5], "radiance": [10, 10, 10]},
+      {"type": "triangle", "corner": [0.2, 1, 0], "edge1": [0.5, 0, 0.5], "edge2": [-0.5, 0, 0.5], "radiance": [10, 10, 10]},
+      {"type": "triangle", "corner": [0.2, 1, 0], "edge1": [-0.5, 0, 0.5], "edge2": [-0.5, 0, -0.5], "radiance": [10, 10, 10]}],)";
+    std::string json = kPlaneScene;
+    const size_t from = json.find(R"("lights": [)"), to = json.find("\n", from);
+    json = json.substr(0, from) + fan + json.substr(to);
+    scene::Scene s(parse(json));
+    ASSERT_EQ(s.desc().lights.size(), 4u);
+    render::Camera camera(s.desc().camera);
+    render::PathSampler sampler(s, camera, false, 5);
+    const ViewGeometry view = sampler.view();
+    ASSERT_EQ(view.lights.size(), 1u);
+    const ViewGeometry::Light& l = view.lights[0];
+    EXPECT_NEAR(length(l.center - Vec3f(0.2f, 1, 0)), 0.f, 1e-6f);
+    EXPECT_NEAR(l.sigma, 0.5f, 1e-6f);  // sqrt(area) / 2 of the whole 1 x 1 light
+    EXPECT_NEAR(dot(l.normal, Vec3f(0, -1, 0)), 1.f, 1e-6f);
+    ASSERT_EQ(l.parts.size(), 4u);
+    for (const auto& part : l.parts) {
+        EXPECT_TRUE(part.triangle);
+        EXPECT_NEAR(part.share, 0.25f, 1e-6f);
+    }
+    render::TracedSample t[16];
+    sampler.traceBatch(12, 12, 0, 16, true, t);
+    for (const auto& sample : t) {
+        EXPECT_EQ(sample.record.light, 0u);
+        EXPECT_NEAR(sample.d1, length(l.center - sample.position), 1e-5f);
+    }
+    render::RenderOptions o;
+    o.quiet = true;
+    o.spp = 256;
+    const Image3f img = render::render(s, o).color;
+    const Image3f whole = renderJson(kPlaneScene, o).color;
+    double a = 0, b = 0;  // the images' means: 256 spp leave each pixel about 1% apart
+    for (size_t i = 0; i < img.size(); ++i) {
+        a += img[i].y;
+        b += whole[i].y;
+    }
+    EXPECT_NEAR(a, b, 0.003 * b);
+}
+
 TEST(Render, SamplesTracedAgainAreTheSamplesAndFindTheirSlot) {
     // What lets MAAF trace the samples of its outer-component pixels again instead of keeping
     // them: the sampler is deterministic per pixel and sample index (whatever the batches and

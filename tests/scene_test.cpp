@@ -97,6 +97,35 @@ TEST(Scene, TwoTriangleLightsIrradianceIsTheirParallelograms) {
     }
 }
 
+TEST(Scene, CoplanarLightsThatShareACornerAreOneGroup) {
+    // A round lamp as a fan of 8 triangles (facing down), as an OBJ tessellates it, is one light
+    // for the filters; lights that do not share a corner, face another way, lie in another plane
+    // or have another radiance stay apart. Groups are numbered by their first light.
+    const Vec3f centre(0.3f, 2.f, -0.2f), radiance(5.f);
+    const float r = 0.4f;
+    std::vector<AreaLight> lights;
+    auto rim = [&](int i) {
+        const float a = 2 * kPi * float(i) / 8;
+        return Vec3f(r * std::cos(a), 0, r * std::sin(a));
+    };
+    for (int i = 0; i < 8; ++i) lights.push_back({centre, rim(i), rim(i + 1), radiance, AreaLight::Shape::Triangle});
+    const Vec3f edge = centre + rim(0);  // a corner on the lamp's rim
+    lights.push_back({edge, {0.3f, 0, 0}, {0, 0, 0.3f}, Vec3f(4.f)});                              // another radiance
+    lights.push_back({edge, {0, 0, 0.3f}, {0.3f, 0, 0}, radiance});                              // facing up
+    lights.push_back({edge, {0.3f, 0.05f, 0}, {0, 0, 0.3f}, radiance});                          // tilted
+    lights.push_back({centre + Vec3f(2, 0, 0), {0.3f, 0, 0}, {0, 0, 0.3f}, radiance});           // apart
+    lights.push_back({edge, {0.3f, 0, 0}, {0, 0, 0.3f}, radiance});                              // joins the lamp
+    lights.push_back({centre + Vec3f(2.3f, 0, 0.3f), {0.2f, 0, 0}, {0, 0, 0.2f}, radiance});     // joins "apart"
+    const std::vector<uint32_t> group = lightGroups(lights);
+    const std::vector<uint32_t> expected = {0, 0, 0, 0, 0, 0, 0, 0, 1, 2, 3, 4, 0, 4};
+    EXPECT_EQ(group, expected);
+    // An emissive box's faces share corners but no plane: six lights.
+    std::vector<AreaLight> box;
+    for (const auto& f : boxFaces({0, 0, 0}, {1, 1, 1})) box.push_back({f[0], f[1], f[2], radiance});
+    const std::vector<uint32_t> six = {0, 1, 2, 3, 4, 5};
+    EXPECT_EQ(lightGroups(box), six);
+}
+
 TEST(Scene, OccluderSpanFindsNearestAndFarthest) {
     SceneDesc d = oneQuad();
     TriangleMesh m;

@@ -22,7 +22,7 @@ struct SampleRecord {
     Vec3f lightPoint;  // the sampled point on the light
     Vec3f bounceDir;   // unit bounce direction; zero when no bounce was traced
     Vec2f lens;        // lens position on the unit disc (x along camera right, y along camera up)
-    uint32_t light = 0;
+    uint32_t light = 0;    // the ViewGeometry light (a group of scene lights) the light sample is on
     float unoccluded = 0;  // luminance of the direct sample without visibility (its weight in visibility filters)
 };
 static_assert(sizeof(SampleRecord) == 64);
@@ -34,10 +34,18 @@ struct ViewGeometry {
     float focalPixels = 1;     // focal length in pixels: (H/2) / tan(fov_y/2)
     float apertureRadius = 0;  // world
     float focusDistance = 1;   // world, along forward
+    /// A light as the filters see it: one scene light, or a group of them that is one planar
+    /// light (scene::lightGroups), over whose outline the samples are uniform.
     struct Light {
-        Vec3f center, normal, axisA, axisB;  // axisA/B: orthonormal in the light plane
-        Vec3f edge1{0.f}, edge2{0.f};          // the edges from the corner (scene::AreaLight)
-        bool triangle = false;               // the triangle (corner, +edge1, +edge2), else the parallelogram
+        /// A scene light of the group: the parallelogram or triangle (corner, corner + edge1,
+        /// corner + edge2), in world space, and its share of the group's area.
+        struct Part {
+            Vec3f corner, edge1, edge2;
+            bool triangle = false;
+            float share = 1;
+        };
+        Vec3f center, normal, axisA, axisB;  // center: the centroid; axisA/B: orthonormal in the light plane
+        std::vector<Part> parts;
         float sigma = 1;                     // Gaussian model of the light: sqrt(area)/2
         float power = 1;                     // luminance of radiance x area
     };

@@ -22,11 +22,11 @@ struct AxisInputs {
     double omegaU = 6;
     double step = 1;                        // world size of a pixel along the axis
     bool fallback = false;                  // the central component only (focal plane; several lights)
-    // The density y is sampled from: a light whose edges from its corner project to (edge1,
-    // edge2) on the axis, a parallelogram or a triangle, or the unit disc of a cosine-weighted
+    // The density y is sampled from: `light` seen along `axis` (the samples' y are their
+    // coordinates from its centroid), or, without a light, the unit disc of a cosine-weighted
     // bounce.
-    bool light = false, triangle = false;
-    double edge1 = 0, edge2 = 0;
+    const ViewGeometry::Light* light = nullptr;
+    Vec3f axis{0.f};
 };
 
 }  // namespace
@@ -38,14 +38,24 @@ MaafWeights parseMaafWeights(const std::string& name, const std::string& flag) {
     throw Error(flag, "expected sampling, eq10 or unit, got '" + name + "'");
 }
 
+/// A part's characteristic function about the light's centroid is its own times e^{iwd}, d its
+/// centre's offset; a parallelogram's own is real.
+double lightSpectrum(double w, const ViewGeometry::Light& light, const Vec3f& axis) {
+    double sum = 0;
+    for (const auto& part : light.parts) {
+        const double x0 = dot(part.corner - light.center, axis), e1 = dot(part.edge1, axis), e2 = dot(part.edge2, axis);
+        sum += part.share * (part.triangle ? triangleSpectrumAt(w, x0, x0 + e1, x0 + e2)
+                                           : std::cos(w * (x0 + 0.5 * (e1 + e2))) * parallelogramSpectrum(w, e1, e2));
+    }
+    return sum;
+}
+
 namespace {
 
 /// The spectrum of the densities a pixel's samples are drawn from at component c's centre: the
 /// light's (or the bounce's) along y, times the lens's along u (maaf.h, "Weights").
 double samplingSpectrum(const MaafComponent& c, const AxisInputs& in) {
-    double mu = !in.light      ? discSpectrum(c.cy)
-                : in.triangle ? triangleSpectrum(c.cy, in.edge1, in.edge2)
-                              : parallelogramSpectrum(c.cy, in.edge1, in.edge2);
+    double mu = in.light ? lightSpectrum(c.cy, *in.light, in.axis) : discSpectrum(c.cy);
     return in.lens ? mu * discSpectrum(c.cu) : mu;
 }
 
@@ -131,7 +141,8 @@ MaafEffect::MaafEffect(const Image<MaafPixel>& params)
 MaafParams maafParams(const FrameBuffers& fb, const WedgeField& wf, const FilterFrames& frames, const ViewGeometry& view,
                       const MaafOptions& o) {
     const int W = fb.width, H = fb.height;
-    // The light whose spectrum weighs the outer components: the scene's only one (below).
+    // The light whose spectrum weighs the outer components: the only one the filters see (below;
+    // a lamp of many coplanar triangles is one, scene::lightGroups).
     const ViewGeometry::Light* single = view.lights.size() == 1 ? &view.lights.front() : nullptr;
     const bool lens = view.apertureRadius > 0;
     Image1f fallback(W, H);
@@ -159,9 +170,9 @@ MaafParams maafParams(const FrameBuffers& fb, const WedgeField& wf, const Filter
     };
     // Direct: the shadow wedge in the light plane.
     // The outer components reproduce the sheared profile of one light (their weights are its
-    // spectrum, their y its coordinates): with several lights, whose samples share a pixel's
-    // accumulations, the direct filter is the central component (axis-aligned). Measured on
-    // a floor, a box and a plank under a large and a small parallelogram (16 spp, 384x384,
+    // spectrum, their y its coordinates): with several lights (groups), whose samples share a
+    // pixel's accumulations, the direct filter is the central component (axis-aligned). Measured
+    // on a floor, a box and a plank under a large and a small parallelogram (16 spp, 384x384,
     // against 512-spp MC): the outer components gave relMSE 0.00495, worse than MC's 0.00278.
     auto direct = [&, common, single, o](size_t p, int k, MaafAxis& out) {
         AxisInputs in;
@@ -179,10 +190,8 @@ MaafParams maafParams(const FrameBuffers& fb, const WedgeField& wf, const Filter
         in.suMin = wf.suMin[p] * in.step;
         in.suMax = wf.suMax[p] * in.step;
         const Vec3f& axis = frames.direct[p].axis[k];
-        in.light = true;
-        in.triangle = single && single->triangle;
-        in.edge1 = single ? dot(single->edge1, axis) : 0.0;  // signed: a triangle's spectrum needs the sign
-        in.edge2 = single ? dot(single->edge2, axis) : 0.0;
+        in.light = single;  // with several lights the weights are unused (central only)
+        in.axis = axis;
         out = buildAxis(in, o);
     };
     // Indirect: the bounce wedge in the tangent plane (z clamped to zMinPixels pixel sizes);

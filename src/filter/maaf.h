@@ -34,8 +34,9 @@
 //    are drawn from the light's and the aperture's own densities, so the kernel over a sample's
 //    (y, u) is sum_p mu_p cos(C_y y + C_u u): a Fourier series that reproduces the sheared light
 //    profile only if mu_p is that density's spectrum at (C_y, C_u). By default mu_p is that
-//    spectrum: parallelogramSpectrum (sinc x sinc of the light's edges projected on the axis; a
-//    triangle light's triangleSpectrum) times discSpectrum (2 J1(w) / w) for the lens;
+//    spectrum: lightSpectrum (sinc x sinc of a parallelogram's edges projected on the axis, a
+//    triangle's triangleSpectrum, or the area-weighted sum of its parts' for a group of lights,
+//    scene::lightGroups) times discSpectrum (2 J1(w) / w) for the lens;
 //    discSpectrum for the cosine-weighted bounce.
 //    Checked numerically on a flatland penumbra (unbounded window, tests/filter_test.cpp,
 //    MaafWeights): N = 3's bias is 0.030 (eq. 10) vs 0.026 under a square light and 0.109 vs
@@ -98,6 +99,10 @@ enum class MaafWeights {
 
 /// "sampling", "eq10" or "unit"; throws Error naming `flag` otherwise.
 MaafWeights parseMaafWeights(const std::string& name, const std::string& flag);
+
+/// E[cos(w y)] for y the projection onto the unit `axis` of a point uniform on `light`, taken
+/// from its centroid: the spectrum the direct components' weights follow (Weights, above).
+double lightSpectrum(double w, const ViewGeometry::Light& light, const Vec3f& axis);
 
 /// mu_p of component c under `weights`; samplingSpectrum() gives the spectrum of the densities
 /// the samples are drawn from at the component's centre (called only for MaafWeights::Sampling).
@@ -237,7 +242,7 @@ struct MaafSample {
     float unoccluded;      // the direct sample's luminance without visibility (0: light behind)
     uint16_t lens[2];      // lens position, unorm16 of (l + 1) / 2
     uint16_t bounce[2];    // bounce direction, octahedral, unorm16
-    uint8_t light, visible;
+    uint8_t light, visible;  // light: the ViewGeometry light (a group of scene lights)
     int8_t slot;           // the pixel's surface slot (PixelStats) the sample went to, -1: none
     uint8_t pad;
 

@@ -50,14 +50,21 @@ double sinc(double x) { return std::abs(x) < 1e-8 ? 1.0 : std::sin(x) / x; }
 double parallelogramSpectrum(double w, double e1, double e2) { return sinc(0.5 * w * e1) * sinc(0.5 * w * e2); }
 
 double triangleSpectrum(double w, double e1, double e2) {
-    // The corners' projections, centred on the mean and sorted: x0 <= x1 <= x2.
-    const double c = (e1 + e2) / 3;
-    double x[3] = {-c, e1 - c, e2 - c};
+    const double c = (e1 + e2) / 3;  // the centroid's projection
+    return triangleSpectrumAt(w, -c, e1 - c, e2 - c);
+}
+
+double triangleSpectrumAt(double w, double x0, double x1, double x2) {
+    // Sorted: x[0] <= x[1] <= x[2].
+    double x[3] = {x0, x1, x2};
     std::sort(x, x + 3);
     const double spread = x[2] - x[0];
-    if (std::abs(w) * spread < 1e-4) {  // E[cos(w y)] = 1 - w^2 Var(y) / 2 + O((w spread)^4)
+    if (std::abs(w) * spread < 1e-4) {
+        // E[e^{iwy}] = e^{iw mean} E[e^{iw(y - mean)}] = e^{iw mean} (1 - w^2 Var(y) / 2 + O((w spread)^3)),
+        // whose imaginary third-order term moves the real part by O((w spread)^3) too.
+        const double mean = (x[0] + x[1] + x[2]) / 3;
         const double var = (x[0] * x[0] + x[1] * x[1] + x[2] * x[2] - x[0] * x[1] - x[0] * x[2] - x[1] * x[2]) / 18;
-        return 1 - 0.5 * w * w * var;
+        return std::cos(w * mean) * (1 - 0.5 * w * w * var);
     }
     // With e = e^{iwy}: e[a, b] = (e(b) - e(a)) / (b - a) = i w e^{iw(a+b)/2} sinc(w (b - a) / 2),
     // 2 f[x0, x1, x2] = -(2 / w^2) (e[x1, x2] - e[x0, x1]) / (x2 - x0), whose real part is

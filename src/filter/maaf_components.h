@@ -56,6 +56,11 @@ double parallelogramSpectrum(double w, double e1, double e2);
 /// Hermite-Genocchi formula. Unlike a parallelogram's, the density is not symmetric about its
 /// centre, and a kernel of cosines reproduces its symmetric part only.
 double triangleSpectrum(double w, double e1, double e2);
+/// The same for a triangle whose corners project to x0, x1, x2, taken from the origin: the real
+/// part of E[e^{iwy}], which for a part of a larger light (a group of lights, ViewGeometry::Light)
+/// is measured from the whole light's centroid. triangleSpectrum(w, e1, e2) is
+/// triangleSpectrumAt(w, -c, e1 - c, e2 - c) with c = (e1 + e2) / 3.
+double triangleSpectrumAt(double w, double x0, double x1, double x2);
 /// y = one coordinate of a point uniform on the unit disc (the lens; a cosine-weighted direction
 /// projected onto its tangent plane): 2 J1(|w|) / |w|.
 double discSpectrum(double w);

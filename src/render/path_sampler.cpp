@@ -21,22 +21,44 @@ PathSampler::PathSampler(const scene::Scene& scene, const Camera& camera, bool i
         m_lightCdf.push_back(total);
     }
     for (float& c : m_lightCdf) c /= total;
+    // The lights the filters see (scene::lightGroups) and their centroids.
+    const auto& lights = scene.desc().lights;
+    m_group = scene::lightGroups(lights);
+    for (size_t i = 0; i < lights.size(); ++i) {
+        if (m_group[i] == m_groupCenter.size()) {
+            m_groupCenter.push_back(Vec3f(0.f));
+            m_groupArea.push_back(0.f);
+        }
+        m_groupCenter[m_group[i]] += lights[i].center() * lights[i].area();
+        m_groupArea[m_group[i]] += lights[i].area();
+    }
+    std::vector<int> parts(m_groupArea.size(), 0);
+    for (uint32_t g : m_group) ++parts[g];
+    for (size_t g = 0; g < m_groupArea.size(); ++g) m_groupCenter[g] = m_groupCenter[g] / m_groupArea[g];
+    for (size_t i = 0; i < lights.size(); ++i)  // a light on its own: its centre to the last bit
+        if (parts[m_group[i]] == 1) m_groupCenter[m_group[i]] = lights[i].center();
 }
 
 ViewGeometry PathSampler::view() const {
     ViewGeometry v = m_camera.view();
-    for (const auto& l : m_scene.desc().lights) {
-        ViewGeometry::Light g;
-        g.center = l.center();
-        g.normal = l.normal();
-        g.axisA = normalize(l.edge1);
-        g.axisB = normalize(cross(g.normal, g.axisA));
-        g.edge1 = l.edge1;
-        g.edge2 = l.edge2;
-        g.triangle = l.triangle();
-        g.sigma = l.sigma();
-        g.power = luminance(l.radiance) * l.area();
-        v.lights.push_back(g);
+    const auto& lights = m_scene.desc().lights;
+    v.lights.resize(m_groupCenter.size());
+    for (size_t i = 0; i < lights.size(); ++i) {
+        const scene::AreaLight& l = lights[i];
+        ViewGeometry::Light& g = v.lights[m_group[i]];
+        if (g.parts.empty()) {  // the group's frame: its first light's
+            g.normal = l.normal();
+            g.axisA = normalize(l.edge1);
+            g.axisB = normalize(cross(g.normal, g.axisA));
+            g.power = 0;
+        }
+        g.parts.push_back({l.corner, l.edge1, l.edge2, l.triangle(), l.area() / m_groupArea[m_group[i]]});
+        g.power += luminance(l.radiance) * l.area();
+    }
+    for (size_t k = 0; k < v.lights.size(); ++k) {
+        ViewGeometry::Light& g = v.lights[k];
+        g.center = m_groupCenter[k];
+        g.sigma = 0.5f * std::sqrt(m_groupArea[k]);  // scene::AreaLight::sigma() of the whole group
     }
     return v;
 }
@@ -93,7 +115,6 @@ void PathSampler::cameraRays(const PixelSampler& rng, int x, int y, uint32_t fir
 void PathSampler::traceBatch(int x, int y, uint32_t first, uint32_t count, bool span, TracedSample* outs) const {
     constexpr int K = scene::RayPacket::kSize;
     const PixelSampler rng(m_seed, uint32_t(y) * uint32_t(m_camera.width()) + uint32_t(x));
-    const auto& lights = m_scene.desc().lights;
     for (uint32_t base = 0; base < count; base += K) {
         const int n = int(std::min<uint32_t>(K, count - base));
         TracedSample* out = outs + base;
@@ -142,12 +163,12 @@ void PathSampler::traceBatch(int x, int y, uint32_t first, uint32_t count, bool 
             o.object = hit[k].object;
             if (front) o.emission = mat[k]->emission;  // emitters shine from their front side
             ls[k] = sampleLight(hit[k].position, normal[k], uLight[k], choice[k]);
-            o.record.light = ls[k].light;
+            o.record.light = m_group[ls[k].light];
             o.record.lightPoint = ls[k].point;
             if (maxComponent(ls[k].irradiance) <= 0) continue;
             o.record.unoccluded = luminance(ls[k].irradiance) * kInvPi;
             o.shadowTested = true;
-            o.d1 = length(lights[ls[k].light].center() - hit[k].position);
+            o.d1 = length(m_groupCenter[o.record.light] - hit[k].position);
             if (dot(ls[k].toLight, geometric[k]) <= 0) {
                 // Above the shading normal's horizon, below the facet's: the surface shadows
                 // itself (no occluder to take a slope from).

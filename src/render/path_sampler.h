@@ -82,7 +82,10 @@ private:
     uint32_t m_seed;
     float m_epsilon;
     bool m_needChoice;  // light choice or shutter time vary
-    std::vector<float> m_lightCdf;  // light choice proportional to power
+    std::vector<float> m_lightCdf;     // light choice proportional to power
+    std::vector<uint32_t> m_group;     // scene light -> its group, the ViewGeometry light (scene::lightGroups)
+    std::vector<Vec3f> m_groupCenter;  // each group's centroid
+    std::vector<float> m_groupArea;
 };
 
 }  // namespace wedge::render

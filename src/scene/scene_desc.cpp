@@ -95,6 +95,47 @@ void smoothCornerNormals(TriangleMesh& mesh, float creaseDegrees) {
     }
 }
 
+std::vector<uint32_t> lightGroups(const std::vector<AreaLight>& lights) {
+    const size_t n = lights.size();
+    std::vector<uint32_t> parent(n);
+    for (size_t i = 0; i < n; ++i) parent[i] = uint32_t(i);
+    auto root = [&](uint32_t i) {
+        while (parent[i] != i) i = parent[i] = parent[parent[i]];
+        return i;
+    };
+    std::vector<std::array<Vec3f, 4>> corners(n);
+    std::vector<int> count(n);
+    std::vector<float> size(n);  // the longest edge: the scale of the tolerances
+    for (size_t i = 0; i < n; ++i) {
+        count[i] = lights[i].vertices(corners[i].data());
+        size[i] = std::max(length(lights[i].edge1), length(lights[i].edge2));
+    }
+    // Float noise from an OBJ's transform leaves shared corners and a common plane equal only to
+    // about 1e-6 of the light's size; 1e-4 of it (and 0.1 degrees between the normals) is far
+    // from any two lights a scene means to keep apart.
+    constexpr float kCosParallel = 0.9999985f;  // cos(0.1 degrees)
+    for (size_t i = 0; i < n; ++i)
+        for (size_t j = i + 1; j < n; ++j) {
+            const AreaLight &a = lights[i], &b = lights[j];
+            if (!(a.radiance == b.radiance) || dot(a.normal(), b.normal()) < kCosParallel) continue;
+            const float tol = 1e-4f * std::max(size[i], size[j]);
+            if (std::abs(dot(a.normal(), b.center() - a.center())) > tol) continue;
+            bool touch = false;
+            for (int u = 0; u < count[i] && !touch; ++u)
+                for (int v = 0; v < count[j] && !touch; ++v) touch = length(corners[i][u] - corners[j][v]) <= tol;
+            if (touch) parent[root(uint32_t(j))] = root(uint32_t(i));
+        }
+    // Number the groups by their first light.
+    std::vector<uint32_t> group(n), number(n, UINT32_MAX);
+    uint32_t next = 0;
+    for (size_t i = 0; i < n; ++i) {
+        uint32_t r = root(uint32_t(i));
+        if (number[r] == UINT32_MAX) number[r] = next++;
+        group[i] = number[r];
+    }
+    return group;
+}
+
 std::array<std::array<Vec3f, 3>, 6> boxFaces(const Vec3f& lo, const Vec3f& hi) {
     const Vec3f d = hi - lo;
     const Vec3f ex(d.x, 0, 0), ey(0, d.y, 0), ez(0, 0, d.z);

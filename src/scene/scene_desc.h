@@ -90,6 +90,13 @@ struct AreaLight {
     float sigma() const { return 0.5f * std::sqrt(area()); }
 };
 
+/// The lights the filters treat as one light: lights that lie in one plane, face the same way,
+/// have the same radiance and share a corner (transitively) are one group, such as a lamp an OBJ
+/// tessellates into triangles. Their samples are then uniform over the group's outline (the
+/// light is chosen by power), so the filters' analysis of one planar light holds for the group.
+/// Returns each light's group, the groups numbered in the order their first light appears.
+std::vector<uint32_t> lightGroups(const std::vector<AreaLight>& lights);
+
 /// At most this many lights in a scene: MAAF's sample records keep a light's index in a byte,
 /// and every pixel sums the closed-form irradiance of every light.
 constexpr size_t kMaxLights = 256;
