@@ -265,6 +265,31 @@ TEST(Cli, MtlTermsThatAreNotRenderedAreNamed) {
     EXPECT_EQ(err.find("warning"), std::string::npos) << err;
 }
 
+TEST(Cli, RasterNamesTheMaterialsWhoseMapsItDoesNotRender) {
+    // wedge raster shades with Kd alone: its warning names the materials with a map_Kd as the
+    // loader's warnings do (the first three and a count).
+    std::string dir = tempDir();
+    wedge::Image3f texels(2, 2);
+    for (size_t i = 0; i < texels.size(); ++i) texels[i] = wedge::Vec3f(0.25f * float(i));
+    wedge::io::writePng(dir + "/t.png", texels);
+    std::string obj = "mtllib quad.mtl\nv -1 0 -1\nv 1 0 -1\nv 1 0 1\nv -1 0 1\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n", mtl;
+    for (const char* m : {"m1", "m2", "m3", "m4"}) {
+        obj += std::string("usemtl ") + m + "\nf 1/1 4/4 3/3\n";
+        mtl += std::string("newmtl ") + m + "\nKd 0.5 0.5 0.5\nmap_Kd t.png\n";
+    }
+    writeFile(dir + "/quad.obj", obj);
+    writeFile(dir + "/quad.mtl", mtl);
+    writeFile(dir + "/s.json", scene(R"({"type": "mesh", "file": "quad.obj"})"));
+    std::string err;
+    ASSERT_EQ(runWedge("raster " + dir + "/s.json --quiet --spp 1 --resolution 8x8 --no-reference -o " + dir + "/x.png", nullptr,
+                       &err),
+              0)
+        << err;
+    EXPECT_NE(err.find("s.json: wedge raster renders the map_Kd of 'quad.obj:m1', 'quad.obj:m2', 'quad.obj:m3' and 1 more as their Kd alone"),
+              std::string::npos)
+        << err;
+}
+
 TEST(Cli, MtlColoursObeyTheSceneFileRules) {
     // An MTL's Kd and Ke are checked as the scene file's "albedo" and "emission" are: they were
     // clamped silently before (a negative albedo to 0, an albedo of 1.2 to 1). Emission above 1

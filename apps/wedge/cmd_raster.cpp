@@ -25,8 +25,8 @@ scene::SceneDesc loadRasterScene(const std::string& name) {
     for (const auto& m : desc.materials)
         if (m.map) mapped.push_back(m.name);
     if (!mapped.empty())
-        desc.warnings.push_back(desc.file + ": wedge raster renders the map_Kd of " + std::to_string(mapped.size()) +
-                                " material(s) ('" + mapped[0] + "'" + (mapped.size() > 1 ? ", ..." : "") + ") as its Kd alone");
+        desc.warnings.push_back(desc.file + ": wedge raster renders the map_Kd of " + scene::nameList(mapped) +
+                                " as their Kd alone");
     printWarnings(desc);
     return desc;
 }

@@ -54,12 +54,6 @@ std::string fewOf(const std::vector<std::string>& items) {
     return s;
 }
 
-/// "'a', 'b', 'c' and 2 more".
-std::string nameList(const std::vector<std::string>& names) {
-    std::vector<std::string> quoted;
-    for (const std::string& n : names) quoted.push_back("'" + n + "'");
-    return fewOf(quoted);
-}
 
 /// Accepts a 4-vertex face as a parallelogram light if v2 = v0 + e1 + e2 up to rounding.
 bool asParallelogram(const Vec3f v[4], AreaLight& light) {
@@ -663,6 +657,12 @@ SceneDesc parseScene(const std::string& jsonText, const std::string& file, const
 std::string scenesDirectory() {
     if (const char* env = std::getenv("WEDGE_SCENES"); env && *env) return env;
     return WEDGE_SCENES_DIR;
+}
+
+std::string nameList(const std::vector<std::string>& names) {
+    std::vector<std::string> quoted;
+    for (const std::string& n : names) quoted.push_back("'" + n + "'");
+    return fewOf(quoted);
 }
 
 std::vector<BuiltinScene> builtinScenes() {

@@ -17,6 +17,8 @@ SceneDesc parseScene(const std::string& jsonText, const std::string& file, const
 struct BuiltinScene {
     std::string name, file, description, attribution;
 };
+/// Names for a warning, quoted, the first three and a count: "'a', 'b', 'c' and 2 more".
+std::string nameList(const std::vector<std::string>& names);
 /// The scenes shipped under scenes/ (listed in scenes/index.json).
 std::vector<BuiltinScene> builtinScenes();
 /// The directory built-in names resolve against: $WEDGE_SCENES, else the source tree's scenes/.
