@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <random>
 #include <tuple>
 
 #include "core/error.h"
@@ -124,6 +125,37 @@ TEST(Scene, CoplanarLightsThatShareACornerAreOneGroup) {
     for (const auto& f : boxFaces({0, 0, 0}, {1, 1, 1})) box.push_back({f[0], f[1], f[2], radiance});
     const std::vector<uint32_t> six = {0, 1, 2, 3, 4, 5};
     EXPECT_EQ(lightGroups(box), six);
+}
+
+TEST(Scene, GroupedIrradianceIsTheSumOverItsLights) {
+    // LightIrradiance sums a group the receiver sees whole over its outline (the shared edges
+    // cancel) and clips a group the horizon cuts light by light: either way the irradiance of
+    // every light, to float precision. A round lamp of 12 triangles, a 3 x 3 grid of quads, and
+    // a lone light, at receivers in front of them, cut by their horizon, and behind them.
+    std::vector<AreaLight> lights;
+    const Vec3f centre(0.2f, 2.f, 0.1f);
+    for (int i = 0; i < 12; ++i) {
+        auto rim = [&](int k) { return Vec3f(0.5f * std::cos(kPi * k / 6), 0, 0.5f * std::sin(kPi * k / 6)); };
+        lights.push_back({centre, rim(i), rim(i + 1), Vec3f(3.f, 2.f, 1.f), AreaLight::Shape::Triangle});
+    }
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j)
+            lights.push_back({Vec3f(-1.5f + 0.3f * i, 1.2f + 0.3f * j, -0.8f), {0.3f, 0, 0}, {0, 0.3f, 0}, Vec3f(1.f, 4.f, 2.f)});
+    lights.push_back({{1.f, 1.f, 1.f}, {0, 0, -0.4f}, {0, 0.3f, 0}, Vec3f(2.f)});
+    const LightIrradiance grouped(lights);
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<float> U(-1.f, 1.f);
+    int cut = 0;
+    for (int i = 0; i < 400; ++i) {
+        const Vec3f x(1.5f * U(rng), 1.f + U(rng), 1.5f * U(rng)), n = normalize(Vec3f(U(rng), U(rng), U(rng)));
+        const Vec3f expected = unoccludedIrradiance(lights, x, n), got = grouped(x, n);
+        for (int c = 0; c < 3; ++c) EXPECT_NEAR(got[c], expected[c], 1e-5f * (1.f + expected[c])) << i;
+        // Count the receivers whose horizon cuts the lamp (some of its corners below it).
+        int below = 0;
+        for (int k = 0; k < 12; ++k) below += dot(lights[k].corner + lights[k].edge1 - x, n) < 0;
+        cut += below > 0 && below < 12 && dot(x - centre, Vec3f(0, -1, 0)) > 0;
+    }
+    EXPECT_GT(cut, 20);  // both paths ran
 }
 
 TEST(Scene, OccluderSpanFindsNearestAndFarthest) {

@@ -41,6 +41,7 @@ MaafWeights parseMaafWeights(const std::string& name, const std::string& flag) {
 /// A part's characteristic function about the light's centroid is its own times e^{iwd}, d its
 /// centre's offset; a parallelogram's own is real.
 double lightSpectrum(double w, const ViewGeometry::Light& light, const Vec3f& axis) {
+    if (w == 0) return 1;  // the central component's (a density integrates to one)
     double sum = 0;
     for (const auto& part : light.parts) {
         const double x0 = dot(part.corner - light.center, axis), e1 = dot(part.edge1, axis), e2 = dot(part.edge2, axis);

@@ -3,7 +3,6 @@
 #include "raster/diffuse_shader.h"
 
 #include "raster/checker_texture.h"
-#include "scene/light_irradiance.h"
 
 namespace wedge::raster {
 
@@ -17,7 +16,7 @@ Vec3f shadeSurface(const RasterScene& scene, const RasterTriangle& tri, const Ve
     // Two-sided: shade the side the camera sees.
     if (dot(tri.faceNormalWorld, scene.camera.position() - p) < 0) n = -n;
     Vec3f albedo = texturedAlbedo(m, pRest, tri.faceNormalWorld, footA, footB);
-    return albedo * scene::unoccludedIrradiance(scene.lights, p, n) * kInvPi;
+    return albedo * scene.irradiance(p, n) * kInvPi;
 }
 
 }  // namespace wedge::raster

@@ -91,7 +91,7 @@ SplitVertex midpoint(const SplitVertex& a, const SplitVertex& b, bool smooth) {
 }  // namespace
 
 RasterScene::RasterScene(const scene::SceneDesc& desc, const SplitPolicy& policy)
-    : camera(desc.camera), materials(desc.materials), lights(desc.lights) {
+    : camera(desc.camera), materials(desc.materials), irradiance(desc.lights) {
     Bounds2 screen{0.f, 0.f, float(camera.width()), float(camera.height())};
     auto offScreen = [&](const Bounds2& b) {
         return b.empty() || b.x1 < screen.x0 || b.y1 < screen.y0 || b.x0 > screen.x1 || b.y0 > screen.y1;

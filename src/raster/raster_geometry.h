@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "raster/raster_camera.h"
+#include "scene/light_irradiance.h"
 #include "scene/scene_desc.h"
 
 namespace wedge::raster {
@@ -130,7 +131,7 @@ struct RasterScene {
     std::vector<RasterTriangle> triangles;  // what is rasterized: the scene's triangles after splitting
     std::vector<RasterTriangle> parents;    // the scene's triangles before splitting (not rasterized)
     std::vector<scene::Material> materials;
-    std::vector<scene::AreaLight> lights;
+    scene::LightIrradiance irradiance;  // the lights' closed-form irradiance (the shader's light)
     size_t culledTriangles = 0;  // degenerate, off screen, or behind the camera for the whole shutter
     bool splitBudgetReached = false;  // kMaxSplitTriangles stopped the split somewhere
 };

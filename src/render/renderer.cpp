@@ -15,14 +15,12 @@ namespace wedge::render {
 std::vector<std::string> methods() { return {"mc", "aaf", "maaf", "atrous"}; }
 
 void storeStats(const PixelStatsImage& stats, const MethodContext& ctx, FrameBuffers& fb) {
-    const auto& lights = ctx.scene.desc().lights;
+    const scene::LightIrradiance irradiance(ctx.scene.desc().lights);
     parallelRows(stats.height(), [&](int y) {
         for (int x = 0; x < stats.width(); ++x) {
             stats(x, y).store(fb, x, y, ctx.view);
             size_t p = size_t(y) * fb.width + x;
-            fb.directUnoccluded[p] =
-                fb.object[p] < 0 ? Vec3f(0.f)
-                                 : scene::unoccludedIrradiance(lights, fb.position[p], fb.normal[p]) * kInvPi;
+            fb.directUnoccluded[p] = fb.object[p] < 0 ? Vec3f(0.f) : irradiance(fb.position[p], fb.normal[p]) * kInvPi;
         }
     });
 }

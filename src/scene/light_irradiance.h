@@ -11,6 +11,26 @@
 namespace wedge::scene {
 
 /// Irradiance at x (unit normal n) from every light, ignoring occluders. One-sided emission.
+/// Light by light; LightIrradiance gives the same faster where lights form groups.
 Vec3f unoccludedIrradiance(const std::vector<AreaLight>& lights, const Vec3f& x, const Vec3f& n);
+
+/// unoccludedIrradiance for many receivers. Lambert's sum runs over the lights' edges, and an
+/// edge two lights of a group (scene::lightGroups: coplanar, facing alike, one radiance) share
+/// is walked once each way and cancels: a group that lies wholly above a receiver's horizon is
+/// summed over its outline alone (a fan of n triangles: n edges instead of 3n). A group the
+/// horizon cuts is clipped light by light, as unoccludedIrradiance does.
+class LightIrradiance {
+public:
+    explicit LightIrradiance(const std::vector<AreaLight>& lights);
+    Vec3f operator()(const Vec3f& x, const Vec3f& n) const;
+
+private:
+    struct Group {
+        Vec3f point, normal, radiance;          // a corner of its first light, its plane, its radiance
+        std::vector<Vec3f> from, to;            // the outline: edges no other light of the group walks back
+        std::vector<AreaLight> lights;
+    };
+    std::vector<Group> m_groups;
+};
 
 }  // namespace wedge::scene
