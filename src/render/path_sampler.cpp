@@ -58,7 +58,8 @@ ViewGeometry PathSampler::view() const {
     for (size_t k = 0; k < v.lights.size(); ++k) {
         ViewGeometry::Light& g = v.lights[k];
         g.center = m_groupCenter[k];
-        g.sigma = 0.5f * std::sqrt(m_groupArea[k]);  // scene::AreaLight::sigma() of the whole group
+        // The Gaussian the analysis treats the light as (NOTES: sqrt(area) / 2), of the whole group.
+        g.sigma = 0.5f * std::sqrt(m_groupArea[k]);
     }
     return v;
 }

@@ -86,8 +86,6 @@ struct AreaLight {
         out[3] = corner + edge2;
         return 4;
     }
-    /// Standard deviation of the Gaussian the analysis treats the light as (NOTES: sqrt(area)/2).
-    float sigma() const { return 0.5f * std::sqrt(area()); }
 };
 
 /// The lights the filters treat as one light: lights that lie in one plane, face the same way,
