@@ -5,7 +5,7 @@ set -euo pipefail
 
 packages=(
   build-essential cmake pkg-config
-  libembree-dev libtbb-dev libopenexr-dev libpng-dev libtinyobjloader-dev
+  libembree-dev libtbb-dev libopenexr-dev libpng-dev libjpeg-dev libtinyobjloader-dev
   nlohmann-json3-dev libcli11-dev libfftw3-dev libgtest-dev libbenchmark-dev
   chromium
 )

@@ -1,5 +1,5 @@
 // Core and I/O: the per-pixel sample generator's stratification and determinism, and image
-// files written and read back (EXR with named channels, PFM orientation, PNG sRGB).
+// files written and read back (EXR with named channels, PFM orientation, PNG sRGB, JPEG texture maps).
 #include <gtest/gtest.h>
 #include <zlib.h>
 
@@ -211,4 +211,58 @@ TEST(ImageIo, HeadersAreCheckedBeforeAllocating) {
     // A PNG cut short: libpng's reason is in wedge's message (not printed by libpng itself).
     test::writeFile(dir + "/cut.png", test::readFile(dir + "/a.png").substr(0, 60));
     EXPECT_NE(readError(dir + "/cut.png").find("corrupt PNG file ("), std::string::npos) << readError(dir + "/cut.png");
+}
+
+
+TEST(ImageIo, JpegTexturesDecodeFromSrgbToLinear) {
+    // Four flat 16 x 16 quadrants (whole blocks, so the lossy code keeps them flat) and a
+    // greyscale image: each pixel is its sRGB byte decoded to linear, to within JPEG's rounding.
+    std::string dir = test::tempDir();
+    const unsigned char quadrant[4][3] = {{200, 40, 40}, {40, 200, 40}, {40, 40, 200}, {128, 128, 128}};
+    std::vector<unsigned char> rgb(32 * 32 * 3), grey(16 * 8, 90);
+    for (int y = 0; y < 32; ++y)
+        for (int x = 0; x < 32; ++x)
+            for (int c = 0; c < 3; ++c) rgb[(size_t(y) * 32 + x) * 3 + c] = quadrant[(y / 16) * 2 + x / 16][c];
+    test::writeJpeg(dir + "/q.jpg", 32, 32, 3, rgb, 95);
+    test::writeJpeg(dir + "/g.jpeg", 16, 8, 1, grey, 95);
+    auto linear = [](int byte) { return byte <= 10 ? byte / 255.f / 12.92f : std::pow((byte / 255.f + 0.055f) / 1.055f, 2.4f); };
+    const Image3f q = io::readJpeg(dir + "/q.jpg");
+    ASSERT_EQ(q.width(), 32);
+    ASSERT_EQ(q.height(), 32);
+    for (int k = 0; k < 4; ++k) {
+        const Vec3f got = q(8 + 16 * (k % 2), 8 + 16 * (k / 2));
+        for (int c = 0; c < 3; ++c)
+            EXPECT_NEAR(got[c], linear(quadrant[k][c]), 0.03f * linear(quadrant[k][c]) + 0.002f) << "quadrant " << k << " channel " << c;
+    }
+    const Image3f g = io::readJpeg(dir + "/g.jpeg");
+    ASSERT_EQ(g.width(), 16);
+    ASSERT_EQ(g.height(), 8);
+    EXPECT_NEAR(g(5, 3).x, linear(90), 0.02f * linear(90));
+    EXPECT_EQ(g(5, 3).x, g(5, 3).y);
+    EXPECT_EQ(g(5, 3).x, g(5, 3).z);
+
+    // Damaged files: errors that name the file, libjpeg's reason kept (not printed by libjpeg).
+    auto jpegError = [](const std::string& path) { return test::errorOf([&] { io::readJpeg(path); }); };
+    test::writeFile(dir + "/text.jpg", "not a jpeg");
+    EXPECT_NE(jpegError(dir + "/text.jpg").find(dir + "/text.jpg: corrupt JPEG file (Not a JPEG file"), std::string::npos)
+        << jpegError(dir + "/text.jpg");
+    const std::string bytes = test::readFile(dir + "/q.jpg");
+    test::writeFile(dir + "/half.jpg", bytes.substr(0, bytes.size() / 2));  // cut in its tables
+    EXPECT_NE(jpegError(dir + "/half.jpg").find("corrupt JPEG file (Invalid JPEG file structure"), std::string::npos)
+        << jpegError(dir + "/half.jpg");
+    // Cut in its pixel data: libjpeg fills the rest with grey and only warns.
+    test::writeFile(dir + "/cut.jpg", bytes.substr(0, bytes.size() - 40));
+    EXPECT_NE(jpegError(dir + "/cut.jpg").find("corrupt JPEG file (it ends early"), std::string::npos) << jpegError(dir + "/cut.jpg");
+    // A frame header (SOF0: FF C0, length, precision, height, width) claiming 60000 x 60000.
+    std::string huge = bytes;
+    const size_t sof = huge.find("\xFF\xC0");
+    ASSERT_NE(sof, std::string::npos);
+    for (size_t at : {sof + 5, sof + 7}) {
+        huge[at] = char(60000 >> 8);
+        huge[at + 1] = char(60000 & 255);
+    }
+    test::writeFile(dir + "/huge.jpg", huge);
+    EXPECT_NE(jpegError(dir + "/huge.jpg").find("the JPEG's header gives 60000x60000 pixels"), std::string::npos)
+        << jpegError(dir + "/huge.jpg");
+    EXPECT_NE(jpegError(dir + "/missing.jpg").find("cannot open"), std::string::npos);
 }

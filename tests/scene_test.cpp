@@ -584,10 +584,10 @@ TEST(SceneFile, ObjDiffuseMapsTextureTheAlbedo) {
 TEST(SceneFile, DiffuseMapsWedgeCannotReadAreNamed) {
     std::string dir = test::tempDir();
     test::writeFile(dir + "/q.obj", "mtllib q.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nusemtl a\nf 1 2 3\nusemtl b\nf 1 3 2\n");
-    test::writeFile(dir + "/q.mtl", "newmtl a\nKd 0.5 0.5 0.5\nmap_Kd wood.jpg\nnewmtl b\nKd 0.5 0.5 0.5\nmap_Kd gone.png\n");
+    test::writeFile(dir + "/q.mtl", "newmtl a\nKd 0.5 0.5 0.5\nmap_Kd wood.tga\nnewmtl b\nKd 0.5 0.5 0.5\nmap_Kd gone.png\n");
     LoadedObj o = loadObjFile(dir + "/q.obj");
     ASSERT_EQ(o.warnings.size(), 1u);
-    EXPECT_NE(o.warnings[0].find("the diffuse maps of 'a' (map_Kd 'wood.jpg': wedge reads PNG textures), 'b' (map_Kd '" + dir +
+    EXPECT_NE(o.warnings[0].find("the diffuse maps of 'a' (map_Kd 'wood.tga': wedge reads PNG and JPEG textures), 'b' (map_Kd '" + dir +
                                  "/gone.png' does not exist) are not rendered"),
               std::string::npos)
         << o.warnings[0];
@@ -626,4 +626,16 @@ TEST(SceneFile, DiffuseMapsWedgeCannotReadAreNamed) {
     test::writeFile(dir + "/t.png", "not a png");
     EXPECT_NE(errorOf([&] { loadObjFile(dir + "/q.obj"); }).find("w: '" + dir + "/q.obj': material 'a': map_Kd: " + dir + "/t.png"),
               std::string::npos);
+    // A JPEG map (.jpg or .jpeg, any case) is read as a JPEG, sRGB to linear; a damaged one is
+    // an error too.
+    test::writeJpeg(dir + "/t.jpeg", 8, 8, 1, std::vector<unsigned char>(64, 188), 90);
+    test::writeFile(dir + "/q.mtl", "newmtl a\nKd 0.5 0.5 0.5\nmap_Kd t.jpeg\nnewmtl b\nKd 0.5 0.5 0.5\n");
+    o = loadObjFile(dir + "/q.obj");
+    ASSERT_TRUE(o.materials[0].map);
+    EXPECT_NEAR(o.materials[0].map->texels(3, 3).y, 0.503f, 0.01f);  // sRGB 188 / 255
+    test::writeFile(dir + "/t.JPG", "not a jpeg");
+    test::writeFile(dir + "/q.mtl", "newmtl a\nKd 0.5 0.5 0.5\nmap_Kd t.JPG\nnewmtl b\nKd 0.5 0.5 0.5\n");
+    EXPECT_NE(errorOf([&] { loadObjFile(dir + "/q.obj"); }).find("material 'a': map_Kd: " + dir + "/t.JPG: corrupt JPEG file"),
+              std::string::npos)
+        << errorOf([&] { loadObjFile(dir + "/q.obj"); });
 }

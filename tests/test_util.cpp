@@ -7,6 +7,10 @@
 #include <sstream>
 #include <sys/wait.h>
 #include <unistd.h>
+// jpeglib.h needs FILE and size_t declared first.
+#include <jpeglib.h>
+
+#include <stdexcept>
 
 namespace fs = std::filesystem;
 
@@ -61,5 +65,29 @@ int runWedge(const std::string& args, std::string* out, std::string* err) {
 }
 
 std::string sourceDir() { return WEDGE_SOURCE_DIR; }
+
+void writeJpeg(const std::string& path, int w, int h, int components, const std::vector<unsigned char>& samples, int quality) {
+    FILE* fp = std::fopen(path.c_str(), "wb");
+    if (!fp) throw std::runtime_error("cannot write " + path);
+    jpeg_compress_struct c;
+    jpeg_error_mgr err;
+    c.err = jpeg_std_error(&err);
+    jpeg_create_compress(&c);
+    jpeg_stdio_dest(&c, fp);
+    c.image_width = JDIMENSION(w);
+    c.image_height = JDIMENSION(h);
+    c.input_components = components;
+    c.in_color_space = components == 3 ? JCS_RGB : JCS_GRAYSCALE;
+    jpeg_set_defaults(&c);
+    jpeg_set_quality(&c, quality, TRUE);
+    jpeg_start_compress(&c, TRUE);
+    while (c.next_scanline < c.image_height) {
+        JSAMPROW row = const_cast<unsigned char*>(&samples[size_t(c.next_scanline) * w * components]);
+        jpeg_write_scanlines(&c, &row, 1);
+    }
+    jpeg_finish_compress(&c);
+    jpeg_destroy_compress(&c);
+    std::fclose(fp);
+}
 
 }  // namespace wedge::test

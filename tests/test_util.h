@@ -2,6 +2,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "core/error.h"
 
@@ -24,6 +25,9 @@ std::string tempDir();
 void writeFile(const std::string& path, const std::string& text);
 /// The bytes of the file at `path` ("" if it cannot be read).
 std::string readFile(const std::string& path);
+/// A baseline JPEG of 8-bit samples (`components` 3: RGB, 1: greyscale), row-major, through
+/// libjpeg: what texture maps in the wild are (wedge itself writes none).
+void writeJpeg(const std::string& path, int w, int h, int components, const std::vector<unsigned char>& samples, int quality);
 /// Runs the wedge binary with `args` (a shell-quoted string); returns the exit code and captures
 /// stderr into `err` and stdout into `out` when given.
 int runWedge(const std::string& args, std::string* out = nullptr, std::string* err = nullptr);

@@ -7,9 +7,13 @@
 #include <OpenEXR/ImfOutputFile.h>
 #include <OpenEXR/ImfThreading.h>
 #include <png.h>
+// jpeglib.h needs size_t and FILE declared first.
+#include <cstdio>
+#include <jpeglib.h>
 
 #include <algorithm>
 #include <atomic>
+#include <csetjmp>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -254,6 +258,72 @@ Image3f readPng(const std::string& path) {
     for (int y = 0; y < h; ++y)
         for (int x = 0; x < w; ++x)
             for (int c = 0; c < 3; ++c) img(x, y)[c] = srgbDecode(pixels[rowBytes * y + 3 * x + c] / 255.f);
+    return img;
+}
+
+// --- JPEG (read only: texture maps) ----------------------------------------------------------
+
+Image3f readJpeg(const std::string& path) {
+    FILE* fp = std::fopen(path.c_str(), "rb");
+    if (!fp) throw Error(path, std::string("cannot open: ") + std::strerror(errno));
+    // libjpeg's default error handler prints and exits; this one keeps the message and jumps back.
+    struct Failure {
+        jpeg_error_mgr base;
+        std::jmp_buf jump;
+        std::string message;
+    } failure;
+    jpeg_decompress_struct jpeg;
+    jpeg.err = jpeg_std_error(&failure.base);
+    failure.base.error_exit = [](j_common_ptr c) {
+        Failure* f = reinterpret_cast<Failure*>(c->err);
+        char text[JMSG_LENGTH_MAX];
+        (*c->err->format_message)(c, text);
+        f->message = text;
+        std::longjmp(f->jump, 1);
+    };
+    // Warnings (a truncated file's, damaged data's) are counted, not printed: they fail the read below.
+    failure.base.emit_message = [](j_common_ptr c, int level) {
+        if (level < 0) ++c->err->num_warnings;
+    };
+    std::vector<unsigned char> pixels;
+    if (setjmp(failure.jump)) {
+        jpeg_destroy_decompress(&jpeg);
+        std::fclose(fp);
+        throw Error(path, "corrupt JPEG file (" + failure.message + ")");
+    }
+    jpeg_create_decompress(&jpeg);
+    jpeg_stdio_src(&jpeg, fp);
+    jpeg_read_header(&jpeg, TRUE);
+    if (uint64_t(jpeg.image_width) * jpeg.image_height > kMaxImagePixels) {
+        const std::string size = std::to_string(jpeg.image_width) + "x" + std::to_string(jpeg.image_height);
+        jpeg_destroy_decompress(&jpeg);
+        std::fclose(fp);
+        throw Error(path, "the JPEG's header gives " + size + " pixels, more than wedge reads (" +
+                              std::to_string(kMaxImageSide) + "x" + std::to_string(kMaxImageSide) + ")");
+    }
+    if (jpeg.jpeg_color_space == JCS_CMYK || jpeg.jpeg_color_space == JCS_YCCK) {
+        jpeg_destroy_decompress(&jpeg);
+        std::fclose(fp);
+        throw Error(path, "a CMYK JPEG (wedge reads RGB and greyscale JPEGs)");
+    }
+    jpeg.out_color_space = JCS_RGB;  // greyscale and YCbCr alike
+    jpeg_start_decompress(&jpeg);
+    const int w = int(jpeg.output_width), h = int(jpeg.output_height);
+    pixels.resize(size_t(w) * h * 3);
+    while (jpeg.output_scanline < jpeg.output_height) {
+        JSAMPROW row = &pixels[size_t(jpeg.output_scanline) * w * 3];
+        jpeg_read_scanlines(&jpeg, &row, 1);
+    }
+    const bool truncated = jpeg.err->num_warnings > 0;
+    jpeg_finish_decompress(&jpeg);
+    jpeg_destroy_decompress(&jpeg);
+    std::fclose(fp);
+    // libjpeg fills a file that ends early with grey and warns ("Premature end of JPEG file").
+    if (truncated) throw Error(path, "corrupt JPEG file (it ends early or has damaged data)");
+    Image3f img(w, h);
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x)
+            for (int c = 0; c < 3; ++c) img(x, y)[c] = srgbDecode(pixels[(size_t(y) * w + x) * 3 + c] / 255.f);
     return img;
 }
 

@@ -1,5 +1,5 @@
 // Image files: OpenEXR (any number of named float channels), PNG (tone-mapped 8-bit sRGB via
-// libpng) and PFM (little-endian, rows bottom to top). Writers go through a temporary file
+// libpng), JPEG (read only, via libjpeg) and PFM (little-endian, rows bottom to top). Writers go through a temporary file
 // and a rename, so a failed write never leaves a half-written output behind.
 #pragma once
 
@@ -32,6 +32,8 @@ void writePng(const std::string& path, const Image3f& linear);
 /// A single-channel image mapped to a perceptual colour ramp over [lo, hi] (debug maps).
 void writePngHeat(const std::string& path, const Image1f& values, float lo, float hi);
 Image3f readPng(const std::string& path);
+/// An 8-bit JPEG (RGB or greyscale), decoded from sRGB to linear: texture maps.
+Image3f readJpeg(const std::string& path);
 
 void writePfm(const std::string& path, const Image3f& linear);
 Image3f readPfm(const std::string& path);

@@ -380,8 +380,9 @@ void parseObjChecked(const std::string& path, const std::string& where, tinyobj:
     if (!parsed) throw Error(where, "cannot read OBJ '" + path + "': " + reader.Error());
 }
 
-/// The material's map_Kd as a TextureMap (PNG files; the OBJ's directory is the search path), or
-/// null with the reason appended to `notRendered` ("'wood' (map_Kd 'wood.jpg': wedge reads PNG textures)").
+/// The material's map_Kd as a TextureMap (PNG and JPEG files; the OBJ's directory is the search
+/// path), or null with the reason appended to `notRendered` ("'wood' (map_Kd 'wood.tga': wedge
+/// reads PNG and JPEG textures)").
 /// Maps shared by several materials are read once (`cache`).
 std::shared_ptr<const TextureMap> diffuseMap(const std::string& objPath, const std::string& where, const tinyobj::material_t& m,
                                              std::map<std::string, std::shared_ptr<const TextureMap>>& cache,
@@ -391,8 +392,9 @@ std::shared_ptr<const TextureMap> diffuseMap(const std::string& objPath, const s
     const fs::path file = fs::path(objPath).parent_path() / name;
     std::string ext = file.extension().string();
     std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
-    if (ext != ".png") {
-        notRendered.push_back("'" + m.name + "' (map_Kd '" + name + "': wedge reads PNG textures)");
+    const bool jpeg = ext == ".jpg" || ext == ".jpeg";
+    if (ext != ".png" && !jpeg) {
+        notRendered.push_back("'" + m.name + "' (map_Kd '" + name + "': wedge reads PNG and JPEG textures)");
         return nullptr;
     }
     if (!fs::is_regular_file(file)) {
@@ -406,7 +408,7 @@ std::shared_ptr<const TextureMap> diffuseMap(const std::string& objPath, const s
     auto map = std::make_shared<TextureMap>();
     map->file = file.string();
     try {
-        map->texels = io::readPng(map->file);  // sRGB decoded to linear
+        map->texels = jpeg ? io::readJpeg(map->file) : io::readPng(map->file);  // sRGB decoded to linear
     } catch (const Error& e) {
         throw Error(where, "'" + objPath + "': material '" + m.name + "': map_Kd: " + e.what());
     }
@@ -421,7 +423,7 @@ std::shared_ptr<const TextureMap> diffuseMap(const std::string& objPath, const s
 
 /// Appends the MTL's materials to the scene's list (named "file.obj:name"); returns the scene
 /// index of each. What wedge does not render (specular terms, transparency, texture maps other
-/// than a PNG map_Kd) is named in one warning per file.
+/// than a PNG or JPEG map_Kd) is named in one warning per file.
 std::vector<uint32_t> appendMtlMaterials(const std::string& path, const std::string& where, const tinyobj::ObjReader& reader,
                                          const std::vector<MtlColours>& mtlColours, std::vector<Material>& materials,
                                          std::vector<std::string>& warnings) {
@@ -479,7 +481,7 @@ std::vector<uint32_t> appendMtlMaterials(const std::string& path, const std::str
         unused += std::string(unused.empty() ? "" : "; ") + "the diffuse maps of " + fewOf(maps);
     if (!unused.empty())
         warnings.push_back(where + ": '" + path + "': " + unused +
-                           " are not rendered (surfaces are Lambertian with the MTL's Kd and PNG map_Kd)");
+                            " are not rendered (surfaces are Lambertian with the MTL's Kd and PNG or JPEG map_Kd)");
     return mtlToScene;
 }
 
