@@ -158,6 +158,29 @@ TEST(Cli, DuplicateKeyNamesItsPath) {
                    "bad.json: objects[1].radius: duplicate key 'radius'");
 }
 
+TEST(Cli, SphereLightsAreCheckedAndRender) {
+    // A sphere light takes a centre, a positive radius and a radiance; anything else is named.
+    const std::string parallelogram =
+        R"({"type": "parallelogram", "corner": [-0.5, 2, -0.5], "edge1": [1, 0, 0], "edge2": [0, 0, 1], "radiance": [5, 5, 5]})";
+    auto sphereLight = [&](const std::string& light) { return scene(kSphere, parallelogram, light); };
+    expectRejected(sphereLight(R"({"type": "sphere", "center": [0, 2, 0], "radius": -1, "radiance": [5, 5, 5]})"),
+                   "bad.json: lights[0].radius: expected a positive number");
+    expectRejected(sphereLight(R"({"type": "sphere", "center": [0, 2, 0], "radiance": [5, 5, 5]})"), "bad.json: lights[0].radius: missing required field");
+    expectRejected(sphereLight(R"({"type": "sphere", "center": [0, 2, 0], "radius": 0.2, "corner": [0, 0, 0], "radiance": [5, 5, 5]})"),
+                   "bad.json: lights[0].corner: unknown key");
+    expectRejected(sphereLight(R"({"type": "sphere", "center": [0, 2, 0], "radius": 1e20, "radiance": [5, 5, 5]})"),
+                   "bad.json: lights[0]: reaches");
+    expectRejected(sphereLight(R"({"type": "disc", "center": [0, 2, 0], "radius": 1, "radiance": [5, 5, 5]})"),
+                   "bad.json: lights[0].type: unknown light type 'disc' (expected \"parallelogram\", \"triangle\" or \"sphere\")");
+    std::string dir = tempDir(), err;
+    writeFile(dir + "/s.json", sphereLight(R"({"type": "sphere", "center": [0, 2, 0], "radius": 0.2, "radiance": [5, 5, 5]})"));
+    for (const char* method : {"mc", "aaf", "maaf", "atrous"}) {
+        EXPECT_EQ(runWedge("render " + dir + "/s.json --quiet --method " + method + " -o " + dir + "/s.png", nullptr, &err), 0)
+            << method << ": " << err;
+        EXPECT_TRUE(fs::exists(dir + "/s.png"));
+    }
+}
+
 TEST(Cli, NumberOutOfRangeNamesItsPath) {
     expectRejected(scene(R"({"type": "sphere", "center": [0, 0, 0], "radius": 1e400, "material": "white"})"),
                    "bad.json: objects[0].radius: invalid JSON: number overflow");

@@ -93,10 +93,15 @@ void expectPenumbraKept(const std::string& json) {
     const int row = 24;
     const Image3f& ref = pen.reference();
     float peak = 0;
-    for (int x = 0; x < ref.width(); ++x) peak = std::max(peak, ref(x, row).y);
-    // Where the reference ramp crosses a level, in pixels (linear interpolation).
+    int darkest = 0;
+    for (int x = 0; x < ref.width(); ++x) {
+        peak = std::max(peak, ref(x, row).y);
+        if (ref(x, row).y < ref(darkest, row).y) darkest = x;
+    }
+    // Where the ramp out of the umbra (rightwards from the reference's darkest pixel) crosses a
+    // level, in pixels (linear interpolation).
     auto crossing = [&](const Image3f& img, float level) {
-        for (int x = 1; x < img.width(); ++x) {
+        for (int x = darkest + 1; x < img.width(); ++x) {
             float a = img(x - 1, row).y, b = img(x, row).y;
             if (a < level && b >= level) return float(x - 1) + (level - a) / (b - a);
         }
@@ -127,6 +132,15 @@ TEST(AafQuality, TriangleLightPenumbraIsNotOverBlurred) {
     // MAAF weights are the triangle's spectrum.
     expectPenumbraKept(replaced(kPenumbra, R"("type": "parallelogram", "corner": [1.8, 3, -0.4])",
                                 R"("type": "triangle", "corner": [1.8, 3, -0.4])"));
+}
+
+TEST(AafQuality, SphereLightPenumbraIsNotOverBlurred) {
+    // kPenumbra's light as a sphere of about its area in cross-section (radius 0.45 about its
+    // centre): the filters size themselves for a disc of that radius facing each receiver, and
+    // MAAF's direct filter is central (a sphere has no one plane for its outer components).
+    expectPenumbraKept(replaced(kPenumbra,
+                                R"({"type": "parallelogram", "corner": [1.8, 3, -0.4], "edge1": [0.8, 0, 0], "edge2": [0, 0, 0.8], "radiance": [60, 60, 60]})",
+                                R"({"type": "sphere", "center": [2.2, 3, 0], "radius": 0.45, "radiance": [60, 60, 60]})"));
 }
 
 TEST(AafQuality, LightsOfTwoSizesStayFiltered) {

@@ -127,6 +127,33 @@ TEST(Render, PlaneUnderTriangleMatchesClosedForm) {
     EXPECT_LT(maxRel, 0.08) << "worst pixel (256 stratified samples)";
 }
 
+TEST(Render, PlaneUnderSphereMatchesClosedForm) {
+    // kPlaneScene's light as a sphere of radius 0.3 about (0.2, 1.6, 0) (above the camera), which
+    // every point of the plane sees whole above its horizon: E = pi L sin^2 alpha cos theta (sin alpha = r / d,
+    // theta from the normal to the centre). Sampled uniformly in the cone the sphere fills.
+    std::string json = kPlaneScene;
+    const size_t from = json.find(R"({"type": "parallelogram")"), to = json.find("}]", from) + 1;
+    json.replace(from, to - from, R"({"type": "sphere", "center": [0.2, 1.6, 0], "radius": 0.3, "radiance": [10, 10, 10]})");
+    render::RenderOptions o;
+    o.quiet = true;
+    render::RenderResult r = renderJson(json, o);
+    double sumRel = 0, maxRel = 0;
+    int n = 0;
+    for (int y = 0; y < r.color.height(); ++y)
+        for (int x = 0; x < r.color.width(); ++x) {
+            const Vec3f w = Vec3f(0.2f, 1.6f, 0) - r.buffers.position(x, y);
+            const double d2 = dot(w, w), cosTheta = w.y / std::sqrt(d2);
+            const double e = 10.0 * kPi * (0.09 / d2) * cosTheta;
+            EXPECT_NEAR(r.buffers.directUnoccluded(x, y).y, e * kInvPi, 1e-4 * e * kInvPi);
+            const double rel = std::abs(r.color(x, y).y - 0.6 * kInvPi * e) / (0.6 * kInvPi * e);
+            sumRel += rel;
+            maxRel = std::max(maxRel, rel);
+            ++n;
+        }
+    EXPECT_LT(sumRel / n, 0.01) << "mean relative error over the image";
+    EXPECT_LT(maxRel, 0.08) << "worst pixel (256 stratified samples)";
+}
+
 TEST(Render, ShadingNormalsOfAnObjSetTheLightCosine) {
     // The plane of kPlaneScene as an OBJ whose `vn` all lean 30 degrees towards +x: the direct
     // light follows Lambert's formula for the leaning normal, not the facet's.

@@ -158,6 +158,48 @@ TEST(Scene, GroupedIrradianceIsTheSumOverItsLights) {
     EXPECT_GT(cut, 20);  // both paths ran
 }
 
+TEST(Scene, SphereLightIrradianceMatchesTheConeItFills) {
+    // A sphere light's irradiance is L times the integral of max(0, n . w) over the cone of
+    // directions it fills; by a fine midpoint rule over the cone (in double), against the closed
+    // form where the cone is above the horizon and the clipped polygon where the horizon cuts it,
+    // and zero behind the horizon and inside the sphere.
+    AreaLight sphere;
+    sphere.shape = AreaLight::Shape::Sphere;
+    sphere.corner = {0.3f, 1.5f, -0.2f};
+    sphere.radius = 0.4f;
+    sphere.radiance = Vec3f(2.f);
+    auto numeric = [&](const Vec3f& x, const Vec3f& n) {
+        const Vec3f w = sphere.corner - x;
+        const double d = length(w), sinA = sphere.radius / d, cosA = std::sqrt(1 - sinA * sinA);
+        const Vec3f axis = w / float(d);
+        const Vec3f a = normalize(cross(axis, std::abs(axis.x) < 0.9f ? Vec3f(1, 0, 0) : Vec3f(0, 1, 0))), b = cross(axis, a);
+        const int nt = 400, np = 400;
+        double sum = 0;
+        for (int i = 0; i < nt; ++i) {
+            const double c = 1 - (i + 0.5) / nt * (1 - cosA), sn = std::sqrt(1 - c * c);  // uniform in solid angle
+            for (int j = 0; j < np; ++j) {
+                const double phi = 2 * M_PI * (j + 0.5) / np;
+                const double cn = c * dot(n, axis) + sn * (std::cos(phi) * dot(n, a) + std::sin(phi) * dot(n, b));
+                sum += std::max(0.0, cn);
+            }
+        }
+        return 2.0 * sphere.radiance.x * M_PI * (1 - cosA) * sum / (double(nt) * np);
+    };
+    const Vec3f x0(0.f, 0.f, 0.f);
+    const Vec3f toCentre = normalize(sphere.corner - x0);
+    const Vec3f side = normalize(cross(toCentre, Vec3f(1, 0, 0)));
+    // Normals from facing the sphere to past the horizon: whole, cut, and gone.
+    for (float tilt : {0.f, 0.5f, 1.2f, 1.35f, 1.5f, 1.57f, 1.65f, 1.75f, 2.2f}) {
+        const Vec3f n = normalize(toCentre * std::cos(tilt) + side * std::sin(tilt));
+        const double expected = numeric(x0, n);
+        const float got = unoccludedIrradiance({sphere}, x0, n).x;
+        EXPECT_NEAR(got, expected, 0.002 * sphere.radiance.x * std::sin(0.4 / length(sphere.corner)) + 0.003 * expected)
+            << "tilt " << tilt;
+        EXPECT_EQ(LightIrradiance({sphere})(x0, n).x, got);
+    }
+    EXPECT_EQ(unoccludedIrradiance({sphere}, sphere.corner + Vec3f(0.1f, 0, 0), {0, 1, 0}).x, 0.f) << "inside";
+}
+
 TEST(Scene, OccluderSpanFindsNearestAndFarthest) {
     SceneDesc d = oneQuad();
     TriangleMesh m;
@@ -438,9 +480,9 @@ TEST(ObjCheck, ShippedMeshesPass) {
 }
 
 TEST(SceneFile, EmittersBecomeLightsOrAreNamed) {
-    // The scene's lights, and the faces of emissive quads, boxes and OBJ meshes that do not move,
-    // are lights; spheres and moving emitters are seen but light nothing, which used to pass
-    // silently, and so are emitters past kMaxLights.
+    // The scene's lights, and emissive quads, boxes, spheres and OBJ meshes that do not move,
+    // are lights; moving emitters are seen but light nothing, which used to pass silently, and
+    // so are emitters past kMaxLights.
     auto warningsOf = [](const std::string& objects, const std::string& dir = ".") {
         const std::string json = R"({
           "camera": {"position": [0, 1, 3], "look_at": [0, 0, 0], "up": [0, 1, 0], "fov_y": 40, "resolution": [8, 8]},
@@ -459,8 +501,13 @@ TEST(SceneFile, EmittersBecomeLightsOrAreNamed) {
     EXPECT_EQ(box, "");
     EXPECT_EQ(boxLights, 7u) << "a box's six faces are lights";
     auto [sphere, sphereLights] = warningsOf(R"({"type": "sphere", "center": [0, 0, 0], "radius": 0.5, "material": "glow"})");
-    EXPECT_EQ(sphere, "s.json: objects[0]: material 'glow' emits, but a sphere is only seen: it lights nothing (spheres are not lights)\n");
-    EXPECT_EQ(sphereLights, 1u);
+    EXPECT_EQ(sphere, "");
+    EXPECT_EQ(sphereLights, 2u) << "a still emissive sphere is a light";
+    auto [movingSphere, movingSphereLights] = warningsOf(
+        R"({"type": "sphere", "center": [0, 0, 0], "radius": 0.5, "material": "glow", "velocity": [1, 0, 0]})");
+    EXPECT_EQ(movingSphere,
+              "s.json: objects[0]: the 1 emissive face(s) of this sphere are only seen and light nothing: moving emitters are not lights\n");
+    EXPECT_EQ(movingSphereLights, 1u);
     auto [moving, movingLights] = warningsOf(
         R"({"type": "box", "min": [0, 0, 0], "max": [1, 1, 1], "material": "glow", "velocity": [1, 0, 0]})");
     EXPECT_EQ(moving, "s.json: objects[0]: the 6 emissive face(s) of this box are only seen and light nothing: moving emitters are not lights\n");

@@ -47,7 +47,10 @@ struct ViewGeometry {
         Vec3f center, normal, axisA, axisB;  // center: the centroid; axisA/B: orthonormal in the light plane
         std::vector<Part> parts;
         float sigma = 1;                     // Gaussian model of the light: sqrt(area)/2
-        float power = 1;                     // luminance of radiance x area
+        float power = 0;                     // luminance of radiance x area
+        /// A sphere light: no plane and no parts; its plane as the filters see it is the one
+        /// facing each receiver (filter_frames.cpp), and MAAF's direct filter is central.
+        bool sphere = false;
     };
     std::vector<Light> lights;
 

@@ -39,6 +39,7 @@ FilterFrames computeFrames(const FrameBuffers& fb, const ViewGeometry& view) {
     const Vec3f nl = view.lights.empty() ? Vec3f(0, 1, 0) : view.lights[ff.light].normal;
     const Vec3f la = view.lights.empty() ? Vec3f(1, 0, 0) : view.lights[ff.light].axisA;
     const Vec3f down = -view.up;
+    const bool sphere = !view.lights.empty() && view.lights[ff.light].sphere;
     parallelRows(fb.height, [&](int y) {
         for (int x = 0; x < fb.width; ++x) {
             size_t p = size_t(y) * fb.width + x;
@@ -60,8 +61,14 @@ FilterFrames computeFrames(const FrameBuffers& fb, const ViewGeometry& view) {
             Vec3f s1 = (view.right - D * (dot(n, view.right) / nD)) * scale;
             Vec3f s2 = (down - D * (dot(n, down) / nD)) * scale;
             ff.indirect[p] = makeFrame(s1, s2, view.right, n);
-            Vec3f p1 = s1 - nl * dot(nl, s1), p2 = s2 - nl * dot(nl, s2);
-            ff.direct[p] = makeFrame(p1, p2, la, nl);
+            // The light's plane; a sphere light's is the one facing this receiver.
+            Vec3f lp = nl, lx = la;
+            if (sphere) {
+                lp = normalize(view.lights[ff.light].center - P);
+                lx = normalize(cross(lp, std::abs(lp.x) < 0.9f ? Vec3f(1, 0, 0) : Vec3f(0, 1, 0)));
+            }
+            Vec3f p1 = s1 - lp * dot(lp, s1), p2 = s2 - lp * dot(lp, s2);
+            ff.direct[p] = makeFrame(p1, p2, lx, lp);
         }
     });
     return ff;

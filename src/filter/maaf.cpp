@@ -143,8 +143,9 @@ MaafParams maafParams(const FrameBuffers& fb, const WedgeField& wf, const Filter
                       const MaafOptions& o) {
     const int W = fb.width, H = fb.height;
     // The light whose spectrum weighs the outer components: the only one the filters see (below;
-    // a lamp of many coplanar triangles is one, scene::lightGroups).
-    const ViewGeometry::Light* single = view.lights.size() == 1 ? &view.lights.front() : nullptr;
+    // a lamp of many coplanar triangles is one, scene::lightGroups), if it is planar (a sphere's
+    // samples have no one plane to take y in: its direct filter is central, as with several).
+    const ViewGeometry::Light* single = view.lights.size() == 1 && !view.lights.front().sphere ? &view.lights.front() : nullptr;
     const bool lens = view.apertureRadius > 0;
     Image1f fallback(W, H);
     parallelRows(H, [&](int y) {

@@ -46,21 +46,27 @@ ViewGeometry PathSampler::view() const {
     for (size_t i = 0; i < lights.size(); ++i) {
         const scene::AreaLight& l = lights[i];
         ViewGeometry::Light& g = v.lights[m_group[i]];
+        g.power += luminance(l.radiance) * l.area();
+        if (l.sphere()) {
+            // Seen from anywhere a disc of its radius, facing the viewer: the Gaussian is that
+            // disc's; no plane, no parts (scene::lightGroups keeps a sphere on its own).
+            g.sphere = true;
+            g.normal = Vec3f(0, 1, 0);
+            g.axisA = Vec3f(1, 0, 0);
+            g.axisB = Vec3f(0, 0, 1);
+            g.sigma = 0.5f * std::sqrt(kPi * l.radius * l.radius);
+            continue;
+        }
         if (g.parts.empty()) {  // the group's frame: its first light's
             g.normal = l.normal();
             g.axisA = normalize(l.edge1);
             g.axisB = normalize(cross(g.normal, g.axisA));
-            g.power = 0;
         }
         g.parts.push_back({l.corner, l.edge1, l.edge2, l.triangle(), l.area() / m_groupArea[m_group[i]]});
-        g.power += luminance(l.radiance) * l.area();
-    }
-    for (size_t k = 0; k < v.lights.size(); ++k) {
-        ViewGeometry::Light& g = v.lights[k];
-        g.center = m_groupCenter[k];
         // The Gaussian the analysis treats the light as (NOTES: sqrt(area) / 2), of the whole group.
-        g.sigma = 0.5f * std::sqrt(m_groupArea[k]);
+        g.sigma = 0.5f * std::sqrt(m_groupArea[m_group[i]]);
     }
+    for (size_t k = 0; k < v.lights.size(); ++k) v.lights[k].center = m_groupCenter[k];
     return v;
 }
 
@@ -73,6 +79,7 @@ PathSampler::LightSample PathSampler::sampleLight(const Vec3f& p, const Vec3f& n
     const scene::AreaLight& light = lights[li];
     LightSample s;
     s.light = li;
+    if (light.sphere()) return sampleSphere(light, li, p, n, u, pChoice);
     s.point = light.pointAt(u.x, u.y);
     Vec3f w = s.point - p;
     s.distance = length(w);
@@ -85,6 +92,39 @@ PathSampler::LightSample PathSampler::sampleLight(const Vec3f& p, const Vec3f& n
         // Uniform area sampling: pdf = 1 / (area * pChoice).
         s.irradiance = light.radiance * (cosX * cosY / (s.distance * s.distance) * light.area() / pChoice);
     }
+    return s;
+}
+
+PathSampler::LightSample PathSampler::sampleSphere(const scene::AreaLight& light, uint32_t index, const Vec3f& p,
+                                                   const Vec3f& n, Vec2f u, float pChoice) const {
+    // Uniform in the cone of directions the sphere fills seen from p (half-angle alpha, sin alpha
+    // = r / d), to the nearer of the two points where a direction meets it: pdf 1 / (2 pi (1 -
+    // cos alpha)) per solid angle. From inside (or on) the sphere nothing: its outside faces away.
+    LightSample s;
+    s.light = index;
+    s.irradiance = Vec3f(0.f);
+    const Vec3f w = light.corner - p;
+    const float d2 = dot(w, w), r2 = light.radius * light.radius;
+    if (d2 <= r2) {
+        s.point = light.corner;
+        s.toLight = Vec3f(0, 1, 0);
+        s.distance = 0;
+        return s;
+    }
+    const float d = std::sqrt(d2), sin2 = r2 / d2;
+    const float oneMinusCos = sin2 / (1.f + std::sqrt(1.f - sin2));  // 1 - cos alpha without cancellation
+    const float cosT = 1.f - u.x * oneMinusCos, sinT = std::sqrt(std::max(0.f, 1.f - cosT * cosT));
+    const float phi = 2.f * kPi * u.y;
+    const Vec3f axis = w / d;
+    const Vec3f a = normalize(cross(axis, std::abs(axis.x) < 0.9f ? Vec3f(1, 0, 0) : Vec3f(0, 1, 0))), b = cross(axis, a);
+    s.toLight = normalize(axis * cosT + a * (sinT * std::cos(phi)) + b * (sinT * std::sin(phi)));
+    // The nearer intersection: t = d cos - sqrt(r^2 - d^2 sin^2), clamped at the silhouette.
+    const float along = dot(w, s.toLight);
+    s.distance = std::max(0.f, along - std::sqrt(std::max(0.f, r2 - (d2 - along * along))));
+    s.point = p + s.toLight * s.distance;
+    const float cosX = dot(n, s.toLight);
+    if (cosX > 0 && s.distance > 0)
+        s.irradiance = light.radiance * (cosX * 2.f * kPi * oneMinusCos / pChoice);  // L cos / (pdf pChoice)
     return s;
 }
 

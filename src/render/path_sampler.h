@@ -69,6 +69,9 @@ private:
         uint32_t light;
     };
     LightSample sampleLight(const Vec3f& p, const Vec3f& n, Vec2f u, float choice) const;
+    /// sampleLight's sample of a sphere light (`index`), chosen with probability pChoice.
+    LightSample sampleSphere(const scene::AreaLight& light, uint32_t index, const Vec3f& p, const Vec3f& n, Vec2f u,
+                             float pChoice) const;
     /// The camera rays of samples first .. first+n-1 (n <= 16) of a pixel into `primary`, with
     /// each sample's lens point, light choice and shutter time: what traceBatch and meanEmission
     /// share, so that they trace the same rays.

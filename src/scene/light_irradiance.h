@@ -26,7 +26,7 @@ public:
 
 private:
     struct Group {
-        Vec3f point, normal, radiance;          // a corner of its first light, its plane, its radiance
+        Vec3f point, normal, radiance;          // a corner of its first light, its plane (0: a sphere), its radiance
         std::vector<Vec3f> from, to;            // the outline: edges no other light of the group walks back
         std::vector<AreaLight> lights;
     };

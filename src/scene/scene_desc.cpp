@@ -117,6 +117,7 @@ std::vector<uint32_t> lightGroups(const std::vector<AreaLight>& lights) {
     for (size_t i = 0; i < n; ++i)
         for (size_t j = i + 1; j < n; ++j) {
             const AreaLight &a = lights[i], &b = lights[j];
+            if (a.sphere() || b.sphere()) continue;
             if (!(a.radiance == b.radiance) || dot(a.normal(), b.normal()) < kCosParallel) continue;
             const float tol = 1e-4f * std::max(size[i], size[j]);
             if (std::abs(dot(a.normal(), b.center() - a.center())) > tol) continue;

@@ -52,30 +52,46 @@ struct CameraDesc {
 
 /// An area light emitting `radiance` from the side of normalize(cross(edge1, edge2)): the
 /// parallelogram corner + a edge1 + b edge2 (a, b in [0, 1]), or the triangle (corner,
-/// corner + edge1, corner + edge2), the parallelogram's half where a + b <= 1.
+/// corner + edge1, corner + edge2), the parallelogram's half where a + b <= 1; or a sphere of
+/// `radius` about `corner` emitting outward (edge1, edge2 unused).
 struct AreaLight {
-    enum class Shape : uint8_t { Parallelogram, Triangle };
+    enum class Shape : uint8_t { Parallelogram, Triangle, Sphere };
 
     Vec3f corner, edge1, edge2, radiance;
     Shape shape = Shape::Parallelogram;
+    float radius = 0;  // a sphere's
 
     bool triangle() const { return shape == Shape::Triangle; }
+    bool sphere() const { return shape == Shape::Sphere; }
+    /// The emitting side's normal (a planar light's; a sphere's differs from point to point).
     Vec3f normal() const { return normalize(cross(edge1, edge2)); }
-    float area() const { return (triangle() ? 0.5f : 1.f) * length(cross(edge1, edge2)); }
+    float area() const {
+        if (sphere()) return 4.f * kPi * radius * radius;
+        return (triangle() ? 0.5f : 1.f) * length(cross(edge1, edge2));
+    }
     /// The centroid.
-    Vec3f center() const { return corner + (edge1 + edge2) * (triangle() ? 1.f / 3.f : 0.5f); }
+    Vec3f center() const {
+        if (sphere()) return corner;
+        return corner + (edge1 + edge2) * (triangle() ? 1.f / 3.f : 0.5f);
+    }
     /// Uniform on the light for (u, v) uniform on the unit square: a triangle folds the square's
     /// half beyond its hypotenuse (u + v > 1) onto its own, which keeps the density uniform and
-    /// the square's stratification.
+    /// the square's stratification; a sphere's point is uniform over its whole surface.
     Vec3f pointAt(float u, float v) const {
+        if (sphere()) {
+            const float z = 1.f - 2.f * u, s = std::sqrt(std::max(0.f, 1.f - z * z)), phi = 2.f * kPi * v;
+            return corner + Vec3f(s * std::cos(phi), s * std::sin(phi), z) * radius;
+        }
         if (triangle() && u + v > 1.f) {
             u = 1.f - u;
             v = 1.f - v;
         }
         return corner + edge1 * u + edge2 * v;
     }
-    /// The outline, counter-clockwise seen from the emitting side: 3 or 4 vertices; returns the count.
+    /// The outline, counter-clockwise seen from the emitting side: 3 or 4 vertices (a sphere: 0);
+    /// returns the count.
     int vertices(Vec3f out[4]) const {
+        if (sphere()) return 0;
         out[0] = corner;
         out[1] = corner + edge1;
         if (triangle()) {

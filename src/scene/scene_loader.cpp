@@ -171,15 +171,23 @@ private:
             std::string type = l["type"].string();
             AreaLight light;
             if (type == "triangle") light.shape = AreaLight::Shape::Triangle;
+            else if (type == "sphere") light.shape = AreaLight::Shape::Sphere;
             else if (type != "parallelogram")
-                l["type"].fail("unknown light type '" + type + "' (expected \"parallelogram\" or \"triangle\")");
-            light.corner = l["corner"].vec3();
-            light.edge1 = l["edge1"].vec3();
-            light.edge2 = l["edge2"].vec3();
-            light.radiance = l["radiance"].color();
-            if (light.area() <= 0) l["edge2"].fail("edge1 and edge2 span no area");
-            Vec3f corners[4];
-            checkExtent(l, std::vector<Vec3f>(corners, corners + light.vertices(corners)));
+                l["type"].fail("unknown light type '" + type + "' (expected \"parallelogram\", \"triangle\" or \"sphere\")");
+            if (light.sphere()) {
+                light.corner = l["center"].vec3();
+                light.radius = float(l["radius"].positive());
+                light.radiance = l["radiance"].color();
+                checkExtent(l, {light.corner - Vec3f(light.radius), light.corner + Vec3f(light.radius)});
+            } else {
+                light.corner = l["corner"].vec3();
+                light.edge1 = l["edge1"].vec3();
+                light.edge2 = l["edge2"].vec3();
+                light.radiance = l["radiance"].color();
+                if (light.area() <= 0) l["edge2"].fail("edge1 and edge2 span no area");
+                Vec3f corners[4];
+                checkExtent(l, std::vector<Vec3f>(corners, corners + light.vertices(corners)));
+            }
             if (m_desc.lights.size() == kMaxLights)
                 l.fail("more than " + std::to_string(kMaxLights) + " lights (MAAF keeps a light's index in a byte)");
             l.finish();
@@ -191,6 +199,10 @@ private:
             mat.emission = light.radiance;
             uint32_t id = uint32_t(m_desc.materials.size());
             m_desc.materials.push_back(mat);
+            if (light.sphere()) {
+                m_desc.spheres.push_back({light.corner, light.radius, id, Vec3f(0.f)});
+                continue;
+            }
             TriangleMesh mesh;
             mesh.name = mat.name;
             if (light.triangle()) appendTriangle(mesh, light.corner, light.edge1, light.edge2, id);
@@ -236,8 +248,13 @@ private:
                 s.radius = float(o["radius"].positive());
                 s.material = material(o["material"]);
                 s.velocity = mesh.velocity;
-                warnIfUnlitSphere(o, s.material);
                 checkExtent(o, {s.center - Vec3f(s.radius), s.center + Vec3f(s.radius)}, s.velocity);
+                AreaLight light;
+                light.shape = AreaLight::Shape::Sphere;
+                light.corner = s.center;
+                light.radius = s.radius;
+                light.radiance = m_desc.materials[s.material].emission;
+                promoteIfEmissive(o, s.material, {light}, s.velocity, "this sphere");
                 o.finish();
                 m_desc.spheres.push_back(s);
                 continue;
@@ -282,12 +299,6 @@ private:
     /// Light comes from the scene's lights and from the emitters that do not move: quads, boxes'
     /// faces and OBJ faces become lights. Spheres are seen (their emission is in the image where
     /// the camera sees them) but light nothing. Say so.
-    void warnIfUnlitSphere(const JsonNode& o, uint32_t mat) {
-        const Material& m = m_desc.materials[mat];
-        if (m.isEmitter())
-            m_desc.warnings.push_back(o.where() + ": material '" + m.name +
-                                      "' emits, but a sphere is only seen: it lights nothing (spheres are not lights)");
-    }
 
     /// Adds an object's emissive faces (those of `owner`) as lights: all of them, or none where
     /// the object moves or they would take the scene past kMaxLights.
