@@ -7,8 +7,7 @@
 #include <OpenEXR/ImfOutputFile.h>
 #include <OpenEXR/ImfThreading.h>
 #include <png.h>
-// jpeglib.h needs size_t and FILE declared first.
-#include <cstdio>
+#include <cstdio>  // before jpeglib.h, which needs FILE and size_t declared
 #include <jpeglib.h>
 
 #include <algorithm>

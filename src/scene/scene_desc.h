@@ -74,14 +74,11 @@ struct AreaLight {
         if (sphere()) return corner;
         return corner + (edge1 + edge2) * (triangle() ? 1.f / 3.f : 0.5f);
     }
-    /// Uniform on the light for (u, v) uniform on the unit square: a triangle folds the square's
-    /// half beyond its hypotenuse (u + v > 1) onto its own, which keeps the density uniform and
-    /// the square's stratification; a sphere's point is uniform over its whole surface.
+    /// Uniform on a planar light for (u, v) uniform on the unit square: a triangle folds the
+    /// square's half beyond its hypotenuse (u + v > 1) onto its own, which keeps the density
+    /// uniform and the square's stratification. (A sphere is sampled from the receiver, in the
+    /// cone it fills: render::PathSampler.)
     Vec3f pointAt(float u, float v) const {
-        if (sphere()) {
-            const float z = 1.f - 2.f * u, s = std::sqrt(std::max(0.f, 1.f - z * z)), phi = 2.f * kPi * v;
-            return corner + Vec3f(s * std::cos(phi), s * std::sin(phi), z) * radius;
-        }
         if (triangle() && u + v > 1.f) {
             u = 1.f - u;
             v = 1.f - v;
