@@ -38,8 +38,10 @@ struct TracedSample {
 class PathSampler {
 public:
     /// Dimension pairs of PixelSampler, in order of use. kPixel draws the pixel and the lens
-    /// position together (PixelSampler::get4DBatch), which takes the place of pair 1.
-    enum Pair : uint32_t { kPixel = 0, kLight = 2, kBounce = 3, kBounceLight = 4, kChoice = 5 };
+    /// position together (PixelSampler::get4DBatch), which takes the place of pair 1; kLight
+    /// draws the light's point with the light choice and the shutter time (its dimensions 2-3,
+    /// where the scene has several lights or motion).
+    enum Pair : uint32_t { kPixel = 0, kLight = 2, kBounce = 3, kBounceLight = 4 };
 
     PathSampler(const scene::Scene& scene, const Camera& camera, bool indirect, uint32_t seed);
 
