@@ -1,9 +1,10 @@
 // Google Benchmark for the hot paths: sample generation, path sampling (rays/s on a built-in
-// scene), the image-space filters (AAF, MAAF accumulation and filter) on rendered buffers, and
-// loading a large OBJ (the text check and the whole load).
+// scene), the image-space filters (AAF, MAAF accumulation and filter) on rendered buffers,
+// loading a large OBJ (the text check and the whole load), and the lights' closed-form irradiance.
 // Run: make bench  (or build/bench/wedge_bench --benchmark_filter=...).
 #include <benchmark/benchmark.h>
 
+#include <cmath>
 #include <memory>
 
 #include "core/sampler.h"
@@ -11,6 +12,7 @@
 #include "filter/maaf.h"
 #include "io/text_file.h"
 #include "render/renderer.h"
+#include "scene/light_irradiance.h"
 #include "scene/obj_check.h"
 #include "scene/scene.h"
 #include "scene/scene_loader.h"
@@ -172,6 +174,28 @@ void BM_LoadSponza(benchmark::State& state) {
     for (auto _ : state) benchmark::DoNotOptimize(scene::loadScene("sponza").triangleCount());
 }
 BENCHMARK(BM_LoadSponza)->Unit(benchmark::kMillisecond)->Iterations(3);
+
+/// The closed-form irradiance at 1024 receivers under a round lamp of state.range(0) triangles
+/// (a fan), light by light (arg 1 = 0) or over the group's outline (scene::LightIrradiance).
+void BM_LampIrradiance(benchmark::State& state) {
+    const int n = int(state.range(0));
+    std::vector<scene::AreaLight> lamp;
+    const Vec3f centre(0.f, 2.f, 0.f);
+    auto rim = [&](int i) { return Vec3f(0.4f * std::cos(2 * kPi * i / n), 0.f, 0.4f * std::sin(2 * kPi * i / n)); };
+    for (int i = 0; i < n; ++i) lamp.push_back({centre, rim(i), rim(i + 1), Vec3f(5.f), scene::AreaLight::Shape::Triangle});
+    const scene::LightIrradiance grouped(lamp);
+    const bool outline = state.range(1) != 0;
+    for (auto _ : state) {
+        Vec3f sum(0.f);
+        for (int k = 0; k < 1024; ++k) {
+            const Vec3f x(float(k % 32) / 16.f - 1.f, 0.f, float(k / 32) / 16.f - 1.f), up(0.f, 1.f, 0.f);
+            sum += outline ? grouped(x, up) : scene::unoccludedIrradiance(lamp, x, up);
+        }
+        benchmark::DoNotOptimize(sum);
+    }
+    state.SetItemsProcessed(state.iterations() * 1024);
+}
+BENCHMARK(BM_LampIrradiance)->ArgsProduct({{12, 250}, {0, 1}})->Unit(benchmark::kMicrosecond);
 
 }  // namespace
 
