@@ -188,6 +188,37 @@ TEST(ExperimentCommand, CachesTheReferenceAndShowsProgressUnlessQuiet) {
     EXPECT_EQ(cached, 2);
 }
 
+TEST(ExperimentCommand, EditingAMeshOrItsMaterialRendersTheReferenceAgain) {
+    // The cache key holds the scene as loaded, not only the scene file's text: an MTL whose Kd
+    // changed (the scene file untouched) must not reuse the old reference.
+    std::string dir = test::tempDir() + "/edit";
+    fs::create_directories(dir);
+    test::writeFile(dir + "/q.obj", "mtllib q.mtl\nv -1 0 -1\nv 1 0 -1\nv 1 0 1\nv -1 0 1\nusemtl m\nf 1 4 3 2\n");
+    test::writeFile(dir + "/q.mtl", "newmtl m\nKd 0.5 0.5 0.5\n");
+    test::writeFile(dir + "/s.json", R"({
+      "camera": {"position": [0, 2, 2], "look_at": [0, 0, 0], "up": [0, 1, 0], "fov_y": 50, "resolution": [12, 12]},
+      "materials": {},
+      "lights": [{"type": "sphere", "center": [0, 1.5, 0], "radius": 0.2, "radiance": [5, 5, 5]}],
+      "objects": [{"type": "mesh", "file": "q.obj"}],
+      "render": {"spp": 4, "seed": 1, "indirect": false}
+    })");
+    const std::string args = "experiment " + dir + "/s.json --methods mc --spp 2 --reference-spp 8 --out " + dir + "/out";
+    auto entries = [&] {
+        int n = 0;
+        for (const auto& e : fs::directory_iterator(dir + "/out/cache")) n += e.path().extension() == ".exr";
+        return n;
+    };
+    std::string out, err;
+    ASSERT_EQ(test::runWedge(args, &out, &err), 0) << err;
+    ASSERT_EQ(test::runWedge(args, &out, &err), 0) << err;
+    EXPECT_NE(err.find("reference from cache"), std::string::npos) << err;
+    EXPECT_EQ(entries(), 1);
+    test::writeFile(dir + "/q.mtl", "newmtl m\nKd 0.9 0.2 0.2\n");
+    ASSERT_EQ(test::runWedge(args, &out, &err), 0) << err;
+    EXPECT_EQ(err.find("reference from cache"), std::string::npos) << err;
+    EXPECT_EQ(entries(), 2);
+}
+
 TEST(ExperimentCommand, BadInputExitsWithTwo) {
     std::string dir = test::tempDir();
     test::writeFile(dir + "/file", "x");

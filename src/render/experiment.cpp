@@ -52,9 +52,51 @@ std::string fileStem(const std::string& name) {
     return stem.empty() ? "scene" : stem;
 }
 
-uint64_t fnv1a(const std::string& bytes, uint64_t h = 1469598103934665603ULL) {
-    for (unsigned char c : bytes) h = (h ^ c) * 1099511628211ULL;
+uint64_t fnv1a(const void* data, size_t size, uint64_t h) {
+    const unsigned char* p = static_cast<const unsigned char*>(data);
+    for (size_t i = 0; i < size; ++i) h = (h ^ p[i]) * 1099511628211ULL;
     return h;
+}
+uint64_t fnv1a(const std::string& bytes, uint64_t h = 1469598103934665603ULL) { return fnv1a(bytes.data(), bytes.size(), h); }
+template <class T>
+uint64_t fnv1a(const std::vector<T>& v, uint64_t h) {
+    h = fnv1a(std::to_string(v.size()), h);
+    return v.empty() ? h : fnv1a(v.data(), v.size() * sizeof(T), h);
+}
+uint64_t fnv1a(const Vec3f& v, uint64_t h) { return fnv1a(&v, sizeof v, h); }
+uint64_t fnv1a(float v, uint64_t h) { return fnv1a(&v, sizeof v, h); }
+
+/// Everything in a scene that shapes its image, as loaded: the meshes OBJ files give and the
+/// materials and texture maps MTL files give, not only the scene file's text, so that editing
+/// a mesh, an MTL or a texture renders the reference again instead of reusing a stale one.
+uint64_t sceneHash(const scene::SceneDesc& d) {
+    uint64_t h = fnv1a(fs::is_regular_file(d.file) ? io::readTextFile(d.file) : std::string());
+    for (const auto& m : d.meshes) {
+        h = fnv1a(m.positions, h);
+        h = fnv1a(m.indices, h);
+        h = fnv1a(m.materialIds, h);
+        h = fnv1a(m.shapeIds, h);
+        h = fnv1a(m.cornerNormals, h);
+        h = fnv1a(m.cornerUVs, h);
+        h = fnv1a(m.velocity, h);
+    }
+    for (const auto& m : d.materials) {
+        h = fnv1a(m.name + "|" + m.texture, fnv1a(m.albedo, fnv1a(m.emission, fnv1a(m.textureScale, h))));
+        if (m.map) {
+            h = fnv1a(m.map->file + (m.map->clamp ? "|clamp" : "|repeat"), h);
+            h = fnv1a(&m.map->scale, sizeof m.map->scale, fnv1a(&m.map->offset, sizeof m.map->offset, h));
+            h = fnv1a(m.map->texels.data(), m.map->texels.size() * sizeof(Vec3f), h);
+        }
+    }
+    for (const auto& l : d.lights) {
+        h = fnv1a(l.corner, fnv1a(l.edge1, fnv1a(l.edge2, fnv1a(l.radiance, fnv1a(l.radius, h)))));
+        h = fnv1a(std::to_string(int(l.shape)), h);
+    }
+    for (const auto& s : d.spheres) h = fnv1a(s.center, fnv1a(s.radius, fnv1a(s.velocity, fnv1a(std::to_string(s.material), h))));
+    const auto& c = d.camera;
+    h = fnv1a(c.position, fnv1a(c.lookAt, fnv1a(c.up, h)));
+    for (float v : {c.fovY, c.apertureRadius, c.focusDistance, c.shutterOpen, c.shutterClose}) h = fnv1a(v, h);
+    return fnv1a(d.render.indirect ? "indirect" : "direct", h);
 }
 
 void writeTextFile(const std::string& path, const std::string& text) {
@@ -175,8 +217,7 @@ private:
 
 void Experiment::loadOrRenderReference() {
     const auto& desc = m_scene.desc();
-    uint64_t hash = fnv1a(fs::is_regular_file(desc.file) ? io::readTextFile(desc.file) : std::string());
-    hash = fnv1a(std::to_string(desc.triangleCount()) + "/" + std::to_string(desc.lights.size()), hash);
+    const uint64_t hash = sceneHash(desc);
     char key[256];
     std::snprintf(key, sizeof key, "reference-%s-%dx%d-%dspp-seed%u-%016" PRIx64, fileStem(m_result.scene).c_str(),
                   m_result.width, m_result.height, m_result.referenceSpp, m_result.referenceSeed, hash);
