@@ -135,7 +135,7 @@ TracedSample PathSampler::trace(int x, int y, uint32_t index, bool span) const {
 }
 
 void PathSampler::cameraRays(const PixelSampler& rng, int x, int y, uint32_t first, int n, scene::RayPacket& primary,
-                             Vec2f* lens, float* choice, float* time) const {
+                             Vec2f* lens, float* choice, float* time, Vec2f* uLight) const {
     constexpr int K = scene::RayPacket::kSize;
     Vec2f uPix[K], uLens[K], uChoice[K];
     // Pixel and lens positions as one 4D Sobol point, so a defocused edge (a discontinuity in
@@ -143,15 +143,19 @@ void PathSampler::cameraRays(const PixelSampler& rng, int x, int y, uint32_t fir
     if (m_camera.hasLens()) rng.get4DBatch(first, uint32_t(n), kPixel, uPix, uLens);
     else rng.get2DBatch(first, uint32_t(n), kPixel, uPix);
     // The light choice and the shutter time as Sobol dimensions 2-3 of the light sample's point
-    // (get4DBatch's first two are exactly the light's get2D(kLight), which traceBatch draws):
+    // (dimensions 0-1, `uLight`, are exactly get2D(kLight) either way):
     // the samples that choose one light are then stratified over it too, and a moving
     // occluder's shadow (a function of time and light point together) is stratified jointly.
     // Against an independent pair (MC at 16 spp, relMSE, three seeds): a square lamp of 4
     // triangles -19%, a 4 x 4 grid of quads -7%, a 12-triangle disc -5%, that disc and a
     // triangle light -5% (docs/lamps); docs/motion.json -20%.
-    Vec2f uLightPoint[K];
-    if (m_needChoice) rng.get4DBatch(first, uint32_t(n), kLight, uLightPoint, uChoice);
-    else std::fill(uChoice, uChoice + n, Vec2f{0, 0});
+    Vec2f scratch[K];
+    if (m_needChoice) {
+        rng.get4DBatch(first, uint32_t(n), kLight, uLight ? uLight : scratch, uChoice);
+    } else {
+        if (uLight) rng.get2DBatch(first, uint32_t(n), kLight, uLight);
+        std::fill(uChoice, uChoice + n, Vec2f{0, 0});
+    }
     for (int k = 0; k < n; ++k) {
         choice[k] = uChoice[k].x;
         time[k] = uChoice[k].y;
@@ -176,7 +180,6 @@ void PathSampler::traceBatch(int x, int y, uint32_t first, uint32_t count, bool 
         // do not matter are not drawn (the others do not depend on it).
         const uint32_t first16 = first + base;
         Vec2f uLight[K], uBounce[K], uBounceLight[K];
-        rng.get2DBatch(first16, uint32_t(n), kLight, uLight);
         if (m_indirect) {
             rng.get2DBatch(first16, uint32_t(n), kBounce, uBounce);
             rng.get2DBatch(first16, uint32_t(n), kBounceLight, uBounceLight);
@@ -185,7 +188,7 @@ void PathSampler::traceBatch(int x, int y, uint32_t first, uint32_t count, bool 
         // Primary rays through the lens.
         scene::RayPacket primary;
         Vec2f lens[K];
-        cameraRays(rng, x, y, first16, n, primary, lens, choice, time);
+        cameraRays(rng, x, y, first16, n, primary, lens, choice, time, uLight);
         for (int k = 0; k < n; ++k) {
             out[k] = TracedSample();
             out[k].record.lens = lens[k];
@@ -302,7 +305,7 @@ Vec3f PathSampler::meanEmission(int x, int y, uint32_t count) const {
         scene::RayPacket primary;
         Vec2f lens[K];
         float choice[K], time[K];
-        cameraRays(rng, x, y, first, n, primary, lens, choice, time);
+        cameraRays(rng, x, y, first, n, primary, lens, choice, time, nullptr);
         scene::Hit hit[K];
         bool found[K] = {};
         m_scene.intersect(primary, hit, found, true);

@@ -75,10 +75,11 @@ private:
     LightSample sampleSphere(const scene::AreaLight& light, uint32_t index, const Vec3f& p, const Vec3f& n, Vec2f u,
                              float pChoice) const;
     /// The camera rays of samples first .. first+n-1 (n <= 16) of a pixel into `primary`, with
-    /// each sample's lens point, light choice and shutter time: what traceBatch and meanEmission
+    /// each sample's lens point, light choice and shutter time, and (unless null) the point it
+    /// samples on the light, drawn with the choice and time: what traceBatch and meanEmission
     /// share, so that they trace the same rays.
     void cameraRays(const PixelSampler& rng, int x, int y, uint32_t first, int n, scene::RayPacket& primary,
-                    Vec2f* lens, float* choice, float* time) const;
+                    Vec2f* lens, float* choice, float* time, Vec2f* uLight) const;
     Vec3f offset(const Vec3f& p, const Vec3f& n) const { return p + n * m_epsilon; }
 
     const scene::Scene& m_scene;
