@@ -12,7 +12,8 @@ Vec3f facing(const Vec3f& shading, const Vec3f& geometric) { return dot(shading,
 }  // namespace
 
 PathSampler::PathSampler(const scene::Scene& scene, const Camera& camera, bool indirect, uint32_t seed)
-    : m_scene(scene), m_camera(camera), m_indirect(indirect), m_seed(seed) {
+    : m_scene(scene), m_camera(camera), m_indirect(indirect), m_seed(seed),
+      m_group(scene::lightGroups(scene.desc().lights)), m_irradiance(scene.desc().lights, m_group) {
     m_epsilon = 1e-5f * scene.extent();
     m_needChoice = scene.desc().lights.size() > 1 || scene.desc().hasMotion();
     float total = 0;
@@ -23,7 +24,6 @@ PathSampler::PathSampler(const scene::Scene& scene, const Camera& camera, bool i
     for (float& c : m_lightCdf) c /= total;
     // The lights the filters see (scene::lightGroups) and their centroids.
     const auto& lights = scene.desc().lights;
-    m_group = scene::lightGroups(lights);
     for (size_t i = 0; i < lights.size(); ++i) {
         if (m_group[i] == m_groupCenter.size()) {
             m_groupCenter.push_back(Vec3f(0.f));

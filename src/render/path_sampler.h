@@ -12,6 +12,7 @@
 #include "core/buffers.h"
 #include "core/sampler.h"
 #include "render/camera.h"
+#include "scene/light_irradiance.h"
 #include "scene/scene.h"
 
 namespace wedge::render {
@@ -61,6 +62,9 @@ public:
     const Camera& camera() const { return m_camera; }
     const scene::Scene& scene() const { return m_scene; }
     ViewGeometry view() const;
+    /// The lights' closed-form irradiance at x (normal n), without occlusion
+    /// (scene::LightIrradiance, built once with the sampler's light groups).
+    Vec3f unoccludedIrradiance(const Vec3f& x, const Vec3f& n) const { return m_irradiance(x, n); }
 
 private:
     struct LightSample {
@@ -92,6 +96,7 @@ private:
     std::vector<uint32_t> m_group;     // scene light -> its group, the ViewGeometry light (scene::lightGroups)
     std::vector<Vec3f> m_groupCenter;  // each group's centroid
     std::vector<float> m_groupArea;
+    scene::LightIrradiance m_irradiance;
 };
 
 }  // namespace wedge::render

@@ -8,19 +8,18 @@
 #include "filter/defocus.h"
 #include "render/methods.h"
 #include "render/sampling.h"
-#include "scene/light_irradiance.h"
 
 namespace wedge::render {
 
 std::vector<std::string> methods() { return {"mc", "aaf", "maaf", "atrous"}; }
 
 void storeStats(const PixelStatsImage& stats, const MethodContext& ctx, FrameBuffers& fb) {
-    const scene::LightIrradiance irradiance(ctx.scene.desc().lights);
     parallelRows(stats.height(), [&](int y) {
         for (int x = 0; x < stats.width(); ++x) {
             stats(x, y).store(fb, x, y, ctx.view);
             size_t p = size_t(y) * fb.width + x;
-            fb.directUnoccluded[p] = fb.object[p] < 0 ? Vec3f(0.f) : irradiance(fb.position[p], fb.normal[p]) * kInvPi;
+            fb.directUnoccluded[p] =
+                fb.object[p] < 0 ? Vec3f(0.f) : ctx.sampler.unoccludedIrradiance(fb.position[p], fb.normal[p]) * kInvPi;
         }
     });
 }

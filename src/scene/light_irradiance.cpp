@@ -105,11 +105,12 @@ Vec3f unoccludedIrradiance(const std::vector<AreaLight>& lights, const Vec3f& xf
     return total;
 }
 
-LightIrradiance::LightIrradiance(const std::vector<AreaLight>& lights) {
-    const std::vector<uint32_t> group = lightGroups(lights);
+LightIrradiance::LightIrradiance(const std::vector<AreaLight>& lights, const std::vector<uint32_t>& group) {
     for (size_t i = 0; i < lights.size(); ++i) {
-        if (group[i] == m_groups.size())
-            m_groups.push_back({lights[i].corner, lights[i].sphere() ? Vec3f(0.f) : lights[i].normal(), lights[i].radiance, {}, {}, {}});
+        if (group[i] == m_groups.size()) {
+            const Vec3f normal = lights[i].sphere() ? Vec3f(0.f) : lights[i].normal();
+            m_groups.push_back({lights[i].corner, normal, lights[i].radiance, {}, {}, {}});
+        }
         m_groups[group[i]].lights.push_back(lights[i]);
     }
     for (Group& g : m_groups) {

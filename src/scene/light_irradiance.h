@@ -21,7 +21,9 @@ Vec3f unoccludedIrradiance(const std::vector<AreaLight>& lights, const Vec3f& x,
 /// horizon cuts is clipped light by light, as unoccludedIrradiance does.
 class LightIrradiance {
 public:
-    explicit LightIrradiance(const std::vector<AreaLight>& lights);
+    explicit LightIrradiance(const std::vector<AreaLight>& lights) : LightIrradiance(lights, lightGroups(lights)) {}
+    /// With the lights' groups already found (lightGroups(lights)).
+    LightIrradiance(const std::vector<AreaLight>& lights, const std::vector<uint32_t>& groups);
     Vec3f operator()(const Vec3f& x, const Vec3f& n) const;
 
 private:
