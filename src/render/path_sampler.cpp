@@ -63,10 +63,13 @@ ViewGeometry PathSampler::view() const {
             g.axisB = normalize(cross(g.normal, g.axisA));
         }
         g.parts.push_back({l.corner, l.edge1, l.edge2, l.triangle(), l.area() / m_groupArea[m_group[i]]});
-        // The Gaussian the analysis treats the light as (NOTES: sqrt(area) / 2), of the whole group.
-        g.sigma = 0.5f * std::sqrt(m_groupArea[m_group[i]]);
     }
-    for (size_t k = 0; k < v.lights.size(); ++k) v.lights[k].center = m_groupCenter[k];
+    for (size_t k = 0; k < v.lights.size(); ++k) {
+        ViewGeometry::Light& g = v.lights[k];
+        g.center = m_groupCenter[k];
+        // The Gaussian the analysis treats the light as (NOTES: sqrt(area) / 2), of the whole group.
+        if (!g.sphere) g.sigma = 0.5f * std::sqrt(m_groupArea[k]);
+    }
     return v;
 }
 
