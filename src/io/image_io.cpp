@@ -34,6 +34,13 @@ namespace {
 /// The most pixels a read image may have: what wedge renders at most.
 constexpr uint64_t kMaxImagePixels = uint64_t(kMaxImageSide) * kMaxImageSide;
 
+/// Why a header's size is more than wedge reads, or "" if it is not.
+std::string oversize(const char* format, uint64_t w, uint64_t h) {
+    if (w * h <= kMaxImagePixels) return "";
+    return std::string("the ") + format + "'s header gives " + std::to_string(w) + "x" + std::to_string(h) +
+           " pixels, more than wedge reads (" + std::to_string(kMaxImageSide) + "x" + std::to_string(kMaxImageSide) + ")";
+}
+
 /// Writes through `write(tmpPath)` and renames onto `path`; removes the temporary on failure.
 template <class Fn>
 void atomicWrite(const std::string& path, Fn&& write) {
@@ -231,13 +238,11 @@ Image3f readPng(const std::string& path) {
     png_read_info(png, info);
     // The header's size is not checked against anything before the pixels are allocated: a
     // damaged or hostile header could ask for terabytes (libpng allows 1,000,000 per side).
-    if (uint64_t(png_get_image_width(png, info)) * png_get_image_height(png, info) > kMaxImagePixels) {
-        const std::string size = std::to_string(png_get_image_width(png, info)) + "x" +
-                                 std::to_string(png_get_image_height(png, info));
+    const std::string why = oversize("PNG", png_get_image_width(png, info), png_get_image_height(png, info));
+    if (!why.empty()) {
         png_destroy_read_struct(&png, &info, nullptr);
         std::fclose(fp);
-        throw Error(path, "the PNG's header gives " + size + " pixels, more than wedge reads (" +
-                              std::to_string(kMaxImageSide) + "x" + std::to_string(kMaxImageSide) + ")");
+        throw Error(path, why);
     }
     png_set_strip_16(png);
     png_set_palette_to_rgb(png);
@@ -293,12 +298,11 @@ Image3f readJpeg(const std::string& path) {
     jpeg_create_decompress(&jpeg);
     jpeg_stdio_src(&jpeg, fp);
     jpeg_read_header(&jpeg, TRUE);
-    if (uint64_t(jpeg.image_width) * jpeg.image_height > kMaxImagePixels) {
-        const std::string size = std::to_string(jpeg.image_width) + "x" + std::to_string(jpeg.image_height);
+    const std::string why = oversize("JPEG", jpeg.image_width, jpeg.image_height);
+    if (!why.empty()) {
         jpeg_destroy_decompress(&jpeg);
         std::fclose(fp);
-        throw Error(path, "the JPEG's header gives " + size + " pixels, more than wedge reads (" +
-                              std::to_string(kMaxImageSide) + "x" + std::to_string(kMaxImageSide) + ")");
+        throw Error(path, why);
     }
     if (jpeg.jpeg_color_space == JCS_CMYK || jpeg.jpeg_color_space == JCS_YCCK) {
         jpeg_destroy_decompress(&jpeg);
