@@ -238,8 +238,9 @@ Image3f readPng(const std::string& path) {
     png_read_info(png, info);
     // The header's size is not checked against anything before the pixels are allocated: a
     // damaged or hostile header could ask for terabytes (libpng allows 1,000,000 per side).
-    const std::string why = oversize("PNG", png_get_image_width(png, info), png_get_image_height(png, info));
-    if (!why.empty()) {
+    // (The message lives in the if's scope only: libpng's later errors longjmp past this point.)
+    if (const std::string why = oversize("PNG", png_get_image_width(png, info), png_get_image_height(png, info));
+        !why.empty()) {
         png_destroy_read_struct(&png, &info, nullptr);
         std::fclose(fp);
         throw Error(path, why);
@@ -298,8 +299,7 @@ Image3f readJpeg(const std::string& path) {
     jpeg_create_decompress(&jpeg);
     jpeg_stdio_src(&jpeg, fp);
     jpeg_read_header(&jpeg, TRUE);
-    const std::string why = oversize("JPEG", jpeg.image_width, jpeg.image_height);
-    if (!why.empty()) {
+    if (const std::string why = oversize("JPEG", jpeg.image_width, jpeg.image_height); !why.empty()) {
         jpeg_destroy_decompress(&jpeg);
         std::fclose(fp);
         throw Error(path, why);
