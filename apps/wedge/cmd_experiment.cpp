@@ -99,8 +99,10 @@ void registerExperiment(CLI::App& app) {
     render::RenderOptions& r = args->options.base;
     cmd->add_option("--max-extra-spp", r.maxExtraSpp, "aaf/maaf: cap on adaptive samples per pixel (default 16; the papers use 100)")
         ->check(numberIn(0, 65536));
-    cmd->add_option("--maaf-components", r.maafComponents, "maaf: filters per 2D/3D subspace (3, 5 or 7)")
-        ->check(CLI::IsMember({3, 5, 7}));
+    cmd->add_option("--maaf-components", r.maafComponents, "maaf: filters per 2D/3D subspace (3, 5 or 7; 1: the central, axis-aligned filter alone)")
+        ->check(CLI::IsMember({1, 3, 5, 7}));
+    cmd->add_flag("--maaf-paper-rates", r.maafPaperRates,
+                  "maaf: adaptive samples only at the focal plane (Sec. 6.2), not also where a filter has outer components");
     cmd->add_flag("!--no-focal-fallback", r.maafFocalFallback,
                   "maaf: keep all components where the defocus slope changes sign");
     cmd->add_option("--maaf-radius", r.maafRadius, "maaf: spatial filter window in pixels (default 10)")

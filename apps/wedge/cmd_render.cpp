@@ -70,8 +70,10 @@ void registerRender(CLI::App& app) {
     cmd->add_option("--aov", args->options.aovDir, "Write PNG debug maps (filter widths, spp, slopes) into this directory");
     cmd->add_option("--max-extra-spp", args->options.maxExtraSpp, "aaf/maaf: cap on adaptive samples per pixel (default 16; the papers use 100)")
         ->check(numberIn(0, 1 << 16));
-    cmd->add_option("--maaf-components", args->options.maafComponents, "maaf: filters per 2D/3D subspace (3, 5 or 7)")
-        ->check(CLI::IsMember({3, 5, 7}));
+    cmd->add_option("--maaf-components", args->options.maafComponents, "maaf: filters per 2D/3D subspace (3, 5 or 7; 1: the central, axis-aligned filter alone)")
+        ->check(CLI::IsMember({1, 3, 5, 7}));
+    cmd->add_flag("--maaf-paper-rates", args->options.maafPaperRates,
+                  "maaf: adaptive samples only at the focal plane (Sec. 6.2), not also where a filter has outer components");
     cmd->add_flag("!--no-focal-fallback", args->options.maafFocalFallback,
                   "maaf: keep all components where the defocus slope changes sign (shows the ringing)");
     cmd->add_flag("--maaf-windows", args->options.maafWindows,
