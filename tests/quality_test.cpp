@@ -196,19 +196,28 @@ TEST(MaafQuality, AllEffectsBeatsMonteCarloAtItsAverageSpp) {
     EXPECT_LT(maaf.relmse, 0.5 * mc.relmse) << "maaf " << maaf.relmse << " at " << maaf.spp << " spp, mc " << mc.relmse;
 }
 
+namespace {
+
+/// MAAF at 8 spp on kPenumbra with the given window (pixels), fit and component count.
+render::RenderResult penumbraMaaf(int radius, bool fit, int components = 5) {
+    render::RenderOptions o;
+    o.quiet = true;
+    o.method = "maaf";
+    o.spp = 8;
+    o.maafRadius = radius;
+    o.maafFit = fit;
+    o.maafComponents = components;
+    return render::render(scene::Scene(scene::parseScene(kPenumbra, "penumbra.json", ".")), o);
+}
+
+}  // namespace
+
 TEST(MaafQuality, WindowAndFitOptionsReachTheFilter) {
     // --maaf-radius and --no-maaf-fit: a wider window holds the outer components in more
     // pixels (and fills more lit pixels with the wedge of the shadow next to them), and without
     // the fit every pixel with a wedge gets them.
-    scene::Scene pen(scene::parseScene(kPenumbra, "penumbra.json", "."));
     auto outerPixels = [&](int radius, bool fit) {
-        render::RenderOptions o;
-        o.quiet = true;
-        o.method = "maaf";
-        o.spp = 8;
-        o.maafRadius = radius;
-        o.maafFit = fit;
-        const std::optional<double> outer = render::render(pen, o).figure("maaf_outer_component_pixels");
+        const std::optional<double> outer = penumbraMaaf(radius, fit).figure("maaf_outer_component_pixels");
         if (!outer) ADD_FAILURE() << "no maaf_outer_component_pixels";
         return outer.value_or(-1.0);
     };
@@ -222,17 +231,7 @@ TEST(MaafQuality, WindowAndFitOptionsReachTheFilter) {
 TEST(MaafQuality, OneComponentIsTheCentralFilterAlone) {
     // --maaf-components 1 (N = 1): MAAF's pipeline with the central, axis-aligned component only,
     // also where every pixel with a wedge would get outer components (no fit).
-    scene::Scene pen(scene::parseScene(kPenumbra, "penumbra.json", "."));
-    auto run = [&](int components) {
-        render::RenderOptions o;
-        o.quiet = true;
-        o.method = "maaf";
-        o.spp = 8;
-        o.maafComponents = components;
-        o.maafFit = false;
-        return render::render(pen, o);
-    };
-    const render::RenderResult one = run(1), three = run(3);
+    const render::RenderResult one = penumbraMaaf(10, false, 1), three = penumbraMaaf(10, false, 3);
     EXPECT_EQ(one.figure("maaf_outer_component_pixels").value_or(-1), 0.0);
     EXPECT_EQ(one.figure("maaf_sample_record_bytes").value_or(-1), 0.0);
     EXPECT_GT(three.figure("maaf_outer_component_pixels").value_or(-1), 0.0);
