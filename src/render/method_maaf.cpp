@@ -146,6 +146,8 @@ void renderMaaf(const MethodContext& ctx, RenderResult& result) {
     Image<uint32_t> extra(W, H);
     const Image<uint32_t> emitterExtra = emitterTopUps(stats, kEmitterEdgeSpp);
     uint64_t extraTotal = 0;
+    // Whether an effect's filter at pixel p has outer components on either image axis.
+    auto outerComponents = [](const filter::MaafEffect& effect, size_t p) { return effect.pairs(p, 0) > 1 || effect.pairs(p, 1) > 1; };
     for (size_t i = 0; i < pixels; ++i) {
         // Sec. 6.2: extra samples where the wedge degenerates at the focal plane, at the AAF
         // (MYRD14) rates, since there the filter is the central, axis-aligned one. Also, unless
@@ -161,13 +163,11 @@ void renderMaaf(const MethodContext& ctx, RenderResult& result) {
         // gave the same on four of the six scenes: the cap binds. AAF's rates everywhere, also
         // where the filter is central: 24-42 spp, relMSE within -10% to +12% of AAF's, and no
         // more efficient than this rule, 0.81-0.97x AAF against 0.78-0.99x.)
-        const bool outerDirect = params.direct.pairs(i, 0) > 1 || params.direct.pairs(i, 1) > 1;
-        const bool outerIndirect = params.indirect.pairs(i, 0) > 1 || params.indirect.pairs(i, 1) > 1;
-        const bool rated = !ctx.options.maafPaperRates;
-        float need = params.fallback[i] > 0 ? std::max({rates.sppDirect[i], rates.sppIndirect[i], rates.sppLens[i]}) : 0.f;
-        if (rated && outerDirect) need = std::max(need, rates.sppDirect[i]);
-        if (rated && outerIndirect) need = std::max(need, rates.sppIndirect[i]);
-        if (rated && (outerDirect || outerIndirect)) need = std::max(need, rates.sppLens[i]);
+        const bool focal = params.fallback[i] > 0, rated = !ctx.options.maafPaperRates;
+        const bool direct = focal || (rated && outerComponents(params.direct, i));
+        const bool indirect = focal || (rated && outerComponents(params.indirect, i));
+        const float need = std::max({direct ? rates.sppDirect[i] : 0.f, indirect ? rates.sppIndirect[i] : 0.f,
+                                     direct || indirect ? rates.sppLens[i] : 0.f});
         extra[i] = std::max(uint32_t(std::clamp(int(std::ceil(need)) - int(n0), 0, cap)),
                             std::max(emitterExtra[i], stats[i].mixedTopUp(kMixedTau, kMixedSpp)));
         extraTotal += extra[i];
@@ -177,8 +177,7 @@ void renderMaaf(const MethodContext& ctx, RenderResult& result) {
     // Pixels whose accumulation has outer components (or windows) need their samples one by
     // one; the others use the pixel statistics' plain sums (below).
     auto outer = [&](size_t p) {
-        return mo.apertureWindows || params.direct.pairs(p, 0) > 1 || params.direct.pairs(p, 1) > 1 ||
-               params.indirect.pairs(p, 0) > 1 || params.indirect.pairs(p, 1) > 1;
+        return mo.apertureWindows || outerComponents(params.direct, p) || outerComponents(params.indirect, p);
     };
 
     // Records of the pixels with outer components (4-19% of the pixels in the 512x512 scenes):
