@@ -118,6 +118,10 @@ void registerExperiment(CLI::App& app) {
     cmd->add_option("--sigma-position", r.atrousSigmaPosition, "atrous: position edge-stopping sigma (pixel footprints)")
         ->check(numberIn(1e-6, 1e6));
     cmd->add_flag("!--no-variance", r.atrousVarianceGuided, "atrous: plain colour edge-stopping instead of variance-guided");
+    cmd->add_option("--layers", r.layers,
+                    "auto (default: on for mc and atrous, off for aaf and maaf), on: the layered reconstruction of "
+                    "defocus and motion blur across pixels, off: each pixel's own samples (and aaf's and maaf's defocus filter)")
+        ->check(CLI::IsMember({"auto", "on", "off"}));
     cmd->add_flag("-q,--quiet", args->options.quiet, "No progress on stderr and no table on stdout");
     cmd->callback([args] {
         args->options.commandLine = commandLine();

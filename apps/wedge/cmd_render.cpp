@@ -99,6 +99,10 @@ void registerRender(CLI::App& app) {
         ->check(numberIn(1e-6, 1e6));
     cmd->add_flag("!--no-variance", args->options.atrousVarianceGuided,
                   "atrous: plain colour edge-stopping instead of variance-guided (SVGF-style)");
+    cmd->add_option("--layers", args->options.layers,
+                    "auto (default: on for mc and atrous, off for aaf and maaf), on: the layered reconstruction of "
+                    "defocus and motion blur across pixels, off: each pixel's own samples (and aaf's and maaf's defocus filter)")
+        ->check(CLI::IsMember({"auto", "on", "off"}));
     cmd->add_flag("-q,--quiet", args->options.quiet, "No progress bar and no summary");
     cmd->callback([args] { runRender(*args); });
 }

@@ -127,6 +127,10 @@ struct FrameBuffers {
     /// the filtered direct and indirect light of the nearest pixel (within 2) whose primary
     /// surface it is (its own samples' light where there is none).
     Image3f composeFiltered(const Image3f& direct, const Image3f& indirect) const;
+    /// The filtered demodulated light of each surface a pixel keeps, as composeFiltered uses it:
+    /// [0] the primary surface's, direct + indirect; [1 + k] other[k]'s, the filtered light of
+    /// the nearest pixel (within 2) whose primary surface it is, or its own samples' light.
+    std::array<Image3f, 1 + kOtherSurfaces> surfaceLight(const Image3f& direct, const Image3f& indirect) const;
 
     /// Every plane with its EXR channel names ("direct.R", "normal.X", "depth", ...).
     void forEachPlane(const std::function<void(const std::string& name, int channels, const float* data)>& fn) const;

@@ -171,10 +171,14 @@ Image3f atrousFilter(const AtrousInput& in, const AtrousParams& params) {
     return out;
 }
 
-Image3f atrousFilter(const FrameBuffers& fb, const AtrousParams& params) {
+Image3f atrousLight(const FrameBuffers& fb, const AtrousParams& params) {
     Image3f light(fb.width, fb.height);
     for (size_t i = 0; i < light.size(); ++i) light[i] = fb.direct[i] + fb.indirect[i];
-    Image3f filtered = atrousFilter(AtrousInput{light, fb.normal, fb.position, fb.footprint, fb.variance}, params);
+    return atrousFilter(AtrousInput{light, fb.normal, fb.position, fb.footprint, fb.variance}, params);
+}
+
+Image3f atrousFilter(const FrameBuffers& fb, const AtrousParams& params) {
+    Image3f filtered = atrousLight(fb, params);
     for (size_t i = 0; i < filtered.size(); ++i) filtered[i] = fb.compose(i, filtered[i], Vec3f(0.f));
     return filtered;
 }

@@ -117,6 +117,9 @@ struct AtrousInput {
 /// are out of range.
 Image3f atrousFilter(const AtrousInput& input, const AtrousParams& params);
 
+/// The primary surfaces' demodulated light (direct + indirect) of `fb`, filtered.
+Image3f atrousLight(const FrameBuffers& fb, const AtrousParams& params);
+
 /// The à-trous method on rendered buffers: fb.compose(filter(direct + indirect)), i.e.
 /// emission + coverage * albedo * filtered light + the unfiltered off-surface samples.
 Image3f atrousFilter(const FrameBuffers& fb, const AtrousParams& params);

@@ -243,6 +243,7 @@ void Experiment::loadOrRenderReference() {
     const int nA = m_result.referenceSpp / 2, nB = m_result.referenceSpp - nA;
     say("rendering the reference: mc, " + std::to_string(m_result.referenceSpp) + " spp in two independent halves");
     RenderOptions o = renderOptions("mc", nA, m_result.referenceSeed, m_options.quiet);
+    o.layers = "off";  // plain Monte Carlo: the layered reconstruction's smoothing is a bias at any spp
     RenderResult a = render(m_scene, o);
     o.spp = nB;
     o.seed = hashCombine(m_result.referenceSeed, 0x68616c66U);

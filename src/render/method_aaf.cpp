@@ -27,9 +27,10 @@ void renderAaf(const MethodContext& ctx, RenderResult& result) {
     PixelStatsImage stats(W, H);
     {
         Progress progress("aaf initial", uint64_t(W) * H * n0, !ctx.options.quiet);
+        LightFieldStage record(ctx.lightField, [&](size_t) { return n0; });
         result.rays += samplePixels(
             ctx.sampler, stats, view, [&](int, int) { return SampleRange{0, n0}; }, true, true,
-            [](int, int, const TracedSample&, int) {}, &progress);
+            [&](int x, int y, const TracedSample& s, int slot) { record.record(x, y, s, slot); }, &progress);
     }
     storeStats(stats, ctx, fb);
     result.seconds.add("sampling_initial", t.seconds());
@@ -57,11 +58,13 @@ void renderAaf(const MethodContext& ctx, RenderResult& result) {
     t.reset();
     {
         Progress progress("aaf adaptive", extraTotal, !ctx.options.quiet && extraTotal > 0);
+        LightFieldStage record(ctx.lightField, [&](size_t p) { return extra[p]; });
         result.rays += samplePixels(
             ctx.sampler, stats, view, [&](int x, int y) { return SampleRange{n0, extra(x, y)}; }, false, false,
-            [](int, int, const TracedSample&, int) {}, &progress);
+            [&](int x, int y, const TracedSample& s, int slot) { record.record(x, y, s, slot); }, &progress);
     }
     storeStats(stats, ctx, fb);
+    finishLightField(ctx, stats);
     result.rays += denseEmission(ctx, emitterExtra, fb);
     stats = PixelStatsImage();  // freed before the filter's buffers: a lower peak, fewer fresh pages
     result.seconds.add("sampling_adaptive", t.seconds());
@@ -75,8 +78,8 @@ void renderAaf(const MethodContext& ctx, RenderResult& result) {
     Image3f visibility =
         filter::aafFilter(visibilityImage(fb), params.omegaDirect, fb, frames.direct, ao, &fb.unoccluded);
     Image3f indirect = filter::aafFilter(fb.indirect, params.omegaIndirect, fb, frames.indirect, ao);
-    result.color = composeFilteredLight(fb, view, visibility, indirect);
-    result.seconds.add("filter", t.seconds());
+    result.seconds.add("filter", t.seconds());  // the layered reconstruction, if any, is timed apart
+    result.color = composeFilteredLight(ctx, visibility, indirect, result);
 
     if (!ctx.options.aovDir.empty()) {
         const std::string& dir = ctx.options.aovDir;

@@ -16,8 +16,16 @@ void renderAtrous(const MethodContext& ctx, RenderResult& result) {
     params.sigmaPosition = ctx.options.atrousSigmaPosition;
     params.varianceGuided = ctx.options.atrousVarianceGuided;
     Timer t;
-    result.color = filter::atrousFilter(result.buffers, params);
-    result.seconds.add("filter", t.seconds());
+    if (ctx.lightField) {
+        // The samples on a pixel's primary surface carry its filtered light, the others their own.
+        const FrameBuffers& fb = result.buffers;
+        const Image3f light = filter::atrousLight(fb, params);
+        result.seconds.add("filter", t.seconds());
+        result.color = reconstructFromLayers(ctx, {&light, nullptr, nullptr}, result);
+    } else {
+        result.color = filter::atrousFilter(result.buffers, params);
+        result.seconds.add("filter", t.seconds());
+    }
     result.extra.emplace_back("atrous_iterations", params.iterations);
     result.extra.emplace_back("atrous_variance_guided", params.varianceGuided ? 1 : 0);
 }

@@ -103,9 +103,11 @@ void renderMaaf(const MethodContext& ctx, RenderResult& result) {
     {
         Progress progress("maaf initial", uint64_t(pixels) * n0, !ctx.options.quiet);
         std::vector<uint32_t> fill(retrace ? 0 : pixels, 0);
+        LightFieldStage record(ctx.lightField, [&](size_t) { return n0; });
         result.rays += samplePixels(
             ctx.sampler, stats, view, [&](int, int) { return SampleRange{0, n0}; }, true, true,
             [&](int x, int y, const TracedSample& s, int slot) {
+                record.record(x, y, s, slot);
                 if (retrace) return;
                 const size_t p = size_t(y) * W + x;
                 initial[p * n0 + fill[p]++] = filter::MaafSample::pack(s.record, view, slot);
@@ -196,15 +198,18 @@ void renderMaaf(const MethodContext& ctx, RenderResult& result) {
     {
         Progress progress("maaf adaptive", extraTotal, !ctx.options.quiet && extraTotal > 0);
         std::vector<uint32_t> fill(pixels, 0);
+        LightFieldStage record(ctx.lightField, [&](size_t p) { return extra[p]; });
         result.rays += samplePixels(
             ctx.sampler, stats, view, [&](int x, int y) { return SampleRange{n0, extra(x, y)}; }, false, false,
             [&](int x, int y, const TracedSample& s, int slot) {
+                record.record(x, y, s, slot);
                 size_t p = size_t(y) * W + x;
                 if (outer(p)) records[offset[p] + again + fill[p]++] = filter::MaafSample::pack(s.record, view, slot);
             },
             &progress);
     }
     storeStats(stats, ctx, fb);
+    finishLightField(ctx, stats);
     result.rays += denseEmission(ctx, emitterExtra, fb);
     result.seconds.add("sampling_adaptive", t.seconds());
 
@@ -300,9 +305,14 @@ void renderMaaf(const MethodContext& ctx, RenderResult& result) {
     Image3f indirect = accIndirect.filter(params.indirect, fb, frames.indirect, fb.indirect, mo);
     result.seconds.add("filter_indirect", part.seconds());
     part.reset();
-    result.color = composeFilteredLight(fb, view, visibility, indirect);
-    result.seconds.add("filter_compose", part.seconds());  // remodulation and the defocus filter
-    result.seconds.add("filter", t.seconds());
+    if (ctx.lightField) {
+        result.seconds.add("filter", t.seconds());  // the layered reconstruction is timed apart
+        result.color = composeFilteredLight(ctx, visibility, indirect, result);
+    } else {
+        result.color = composeFilteredLight(ctx, visibility, indirect, result);
+        result.seconds.add("filter_compose", part.seconds());  // remodulation and the defocus filter
+        result.seconds.add("filter", t.seconds());
+    }
 
     if (!ctx.options.aovDir.empty()) {
         const std::string& dir = ctx.options.aovDir;

@@ -2,8 +2,10 @@
 // fills a RenderResult (colour, buffers, stage times, sample and ray counts).
 #pragma once
 
+#include <array>
 #include <string>
 
+#include "core/light_field.h"
 #include "core/progress.h"
 #include "render/path_sampler.h"
 #include "render/pixel_stats.h"
@@ -17,6 +19,9 @@ struct MethodContext {
     const PathSampler& sampler;
     ViewGeometry view;
     int spp;  // the method's base sample count
+    /// Every sample, for the layered reconstruction (RenderOptions::layers); null when off or
+    /// when the camera has no lens and nothing moves (nothing to reconstruct across pixels).
+    LightFieldSamples* lightField = nullptr;
 };
 
 void renderMc(const MethodContext& ctx, RenderResult& result);
@@ -54,6 +59,7 @@ uint64_t denseEmission(const MethodContext& ctx, const Image<uint32_t>& topUp, F
 constexpr float kMixedTau = 0.01f;
 constexpr uint32_t kMixedSpp = 64;
 
+
 /// Monte Carlo sampling as `mc` does it: ctx.spp samples per pixel, then the emitter-edge
 /// top-up, into pixel statistics of its own. Adds the rays to result.rays, fills result.buffers,
 /// and times "sampling" (the statistics' allocation included).
@@ -64,13 +70,24 @@ void storeStats(const PixelStatsImage& stats, const MethodContext& ctx, FrameBuf
 /// Average samples per pixel of `fb.spp`.
 double averageSpp(const FrameBuffers& fb);
 
+/// The samples' surfaces in ctx.lightField (PixelStats slots as they were taken) become
+/// FrameBuffers surfaces (0 the primary, 1 + k other[k]), once the statistics are final.
+void finishLightField(const MethodContext& ctx, const PixelStatsImage& stats);
+/// The image of a method whose samples carry `surfaceLight` (null entries: their own radiance;
+/// filter/layers.h): each pixel's emission plus the layered reconstruction of the reflected light
+/// from ctx.lightField. Times the "layers" stage and adds its figures to result.extra.
+Image3f reconstructFromLayers(const MethodContext& ctx, const std::array<const Image3f*, 1 + FrameBuffers::kOtherSurfaces>& surfaceLight,
+                              RenderResult& result);
+
 /// The primary surface's visibility as rgb, the input of the direct-light filters.
 Image3f visibilityImage(const FrameBuffers& fb);
 /// The last step of aaf and maaf: direct light as the closed-form unoccluded irradiance times
 /// the filtered visibility (AAF report eq. 3.2), composed with the filtered indirect light
 /// (FrameBuffers::composeFiltered), then, where the camera has a lens, the defocus filter of the
 /// composited radiance (filter/defocus.h).
-Image3f composeFilteredLight(const FrameBuffers& fb, const ViewGeometry& view, const Image3f& filteredVisibility,
-                             const Image3f& filteredIndirect);
+/// With ctx.lightField, the layered reconstruction (reconstructFromLayers) takes the place of the
+/// composition and the defocus filter.
+Image3f composeFilteredLight(const MethodContext& ctx, const Image3f& filteredVisibility, const Image3f& filteredIndirect,
+                             RenderResult& result);
 
 }  // namespace wedge::render

@@ -138,7 +138,7 @@ TracedSample PathSampler::trace(int x, int y, uint32_t index, bool span) const {
 }
 
 void PathSampler::cameraRays(const PixelSampler& rng, int x, int y, uint32_t first, int n, scene::RayPacket& primary,
-                             Vec2f* lens, float* choice, float* time, Vec2f* uLight) const {
+                             Vec2f* lens, float* choice, float* time, Vec2f* uLight, Vec2f* film) const {
     constexpr int K = scene::RayPacket::kSize;
     Vec2f uPix[K], uLens[K], uChoice[K];
     // Pixel and lens positions as one 4D Sobol point, so a defocused edge (a discontinuity in
@@ -163,6 +163,7 @@ void PathSampler::cameraRays(const PixelSampler& rng, int x, int y, uint32_t fir
         choice[k] = uChoice[k].x;
         time[k] = uChoice[k].y;
         lens[k] = m_camera.hasLens() ? concentricDisc(uLens[k].x, uLens[k].y) : Vec2f{0, 0};
+        if (film) film[k] = uPix[k];
         Ray ray = m_camera.generate(float(x) + uPix[k].x, float(y) + uPix[k].y, lens[k]);
         primary.set(k, ray.origin, ray.direction, kInf, time[k]);
     }
@@ -190,11 +191,13 @@ void PathSampler::traceBatch(int x, int y, uint32_t first, uint32_t count, bool 
 
         // Primary rays through the lens.
         scene::RayPacket primary;
-        Vec2f lens[K];
-        cameraRays(rng, x, y, first16, n, primary, lens, choice, time, uLight);
+        Vec2f lens[K], film[K];
+        cameraRays(rng, x, y, first16, n, primary, lens, choice, time, uLight, film);
         for (int k = 0; k < n; ++k) {
             out[k] = TracedSample();
             out[k].record.lens = lens[k];
+            out[k].film = film[k];
+            out[k].time = time[k];
             out[k].rays = 1;
         }
         scene::Hit hit[K];
@@ -216,6 +219,13 @@ void PathSampler::traceBatch(int x, int y, uint32_t first, uint32_t count, bool 
             o.position = hit[k].position;
             o.depth = m_camera.depth(hit[k].position);
             o.object = hit[k].object;
+            if (lengthSquared(hit[k].displacement) > 0) {
+                // The hit point's path over the shutter, through the lens centre.
+                const Vec3f& d = hit[k].displacement;
+                const Vec2f open = m_camera.project(hit[k].position - d * time[k]);
+                const Vec2f close = m_camera.project(hit[k].position + d * (1.f - time[k]));
+                o.motion = {close.x - open.x, close.y - open.y};
+            }
             if (front) o.emission = mat[k]->emission;  // emitters shine from their front side
             ls[k] = sampleLight(hit[k].position, normal[k], uLight[k], choice[k]);
             o.record.light = m_group[ls[k].light];

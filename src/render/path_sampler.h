@@ -25,6 +25,11 @@ struct TracedSample {
     Vec3f emission{0.f}, albedo{0.f}, normal{0.f}, position{0.f};
     float depth = 0;
     uint32_t object = 0;
+    // Where on the film (the position in the pixel, [0, 1)^2) and when (the shutter time, [0,
+    // 1]) it was taken, and how far its hit moves on the screen over the whole shutter (pixels,
+    // through the lens centre): the light-field coordinates of the layered reconstruction.
+    Vec2f film{0.f, 0.f}, motion{0.f, 0.f};
+    float time = 0;
     // Shadow ray of the primary hit (only when the light faced the receiver).
     bool shadowTested = false, occluded = false;
     bool selfShadowed = false;     // the light is above the shading normal's horizon but below the facet's
@@ -60,6 +65,7 @@ public:
     Vec3f meanEmission(int x, int y, uint32_t count) const;
 
     const Camera& camera() const { return m_camera; }
+    uint32_t seed() const { return m_seed; }
     const scene::Scene& scene() const { return m_scene; }
     ViewGeometry view() const;
     /// The lights' closed-form irradiance at x (normal n), without occlusion
@@ -83,7 +89,7 @@ private:
     /// samples on the light, drawn with the choice and time: what traceBatch and meanEmission
     /// share, so that they trace the same rays.
     void cameraRays(const PixelSampler& rng, int x, int y, uint32_t first, int n, scene::RayPacket& primary,
-                    Vec2f* lens, float* choice, float* time, Vec2f* uLight) const;
+                    Vec2f* lens, float* choice, float* time, Vec2f* uLight, Vec2f* film = nullptr) const;
     Vec3f offset(const Vec3f& p, const Vec3f& n) const { return p + n * m_epsilon; }
 
     const scene::Scene& m_scene;

@@ -6,6 +6,7 @@
 #include "core/error.h"
 #include "core/parallel.h"
 #include "filter/defocus.h"
+#include "filter/layers.h"
 #include "render/methods.h"
 #include "render/sampling.h"
 
@@ -73,12 +74,53 @@ Image3f visibilityImage(const FrameBuffers& fb) {
     return v;
 }
 
-Image3f composeFilteredLight(const FrameBuffers& fb, const ViewGeometry& view, const Image3f& filteredVisibility,
-                             const Image3f& filteredIndirect) {
+void finishLightField(const MethodContext& ctx, const PixelStatsImage& stats) {
+    if (!ctx.lightField) return;
+    LightFieldSamples& lf = *ctx.lightField;
+    parallelRows(lf.height(), [&](int y) {
+        for (int x = 0; x < lf.width(); ++x) {
+            const size_t p = size_t(y) * lf.width() + x;
+            const int primary = stats(x, y).primary();
+            // PixelStats::store's order: the primary slot, then the others in slot order.
+            lf.forEachMutable(p, [&](LightFieldSample& s) {
+                const int k = s.surface();
+                if (k >= 0) s.setSurface(k == primary ? 0 : 1 + (k < primary ? k : k - 1));
+            });
+        }
+    });
+}
+
+Image3f reconstructFromLayers(const MethodContext& ctx,
+                              const std::array<const Image3f*, 1 + FrameBuffers::kOtherSurfaces>& surfaceLight,
+                              RenderResult& result) {
+    Timer t;
+    const FrameBuffers& fb = result.buffers;
+    filter::LayerOptions lo;
+    lo.seed = ctx.sampler.seed();
+    filter::LayerStats stats;
+    Image3f color = filter::reconstructLayers(filter::LayerInput{*ctx.lightField, ctx.view, surfaceLight}, lo, &stats);
+    parallelRows(fb.height, [&](int y) {
+        for (size_t p = size_t(y) * fb.width; p < size_t(y + 1) * fb.width; ++p) color[p] += fb.emission[p];
+    });
+    result.seconds.add("layers", t.seconds());
+    result.extra.emplace_back("layers_sample_bytes", double(ctx.lightField->bytes()));
+    result.extra.emplace_back("layers_gathered_per_pixel", stats.gatheredPerPixel);
+    result.extra.emplace_back("layers_per_tile", stats.layersPerTile);
+    result.extra.emplace_back("layers_blurred_tiles", stats.blurredTiles);
+    return color;
+}
+
+Image3f composeFilteredLight(const MethodContext& ctx, const Image3f& filteredVisibility, const Image3f& filteredIndirect,
+                             RenderResult& result) {
+    const FrameBuffers& fb = result.buffers;
     Image3f direct(fb.width, fb.height);
     for (size_t i = 0; i < direct.size(); ++i) direct[i] = fb.directUnoccluded[i] * filteredVisibility[i].x;
+    if (ctx.lightField) {
+        const std::array<Image3f, 1 + FrameBuffers::kOtherSurfaces> light = fb.surfaceLight(direct, filteredIndirect);
+        return reconstructFromLayers(ctx, {&light[0], &light[1], &light[2]}, result);
+    }
     Image3f color = fb.composeFiltered(direct, filteredIndirect);
-    return view.apertureRadius > 0 ? filter::defocusFilter(color, fb) : color;
+    return ctx.view.apertureRadius > 0 ? filter::defocusFilter(color, fb) : color;
 }
 
 double averageSpp(const FrameBuffers& fb) {
@@ -92,17 +134,20 @@ void sampleUniform(const MethodContext& ctx, const std::string& label, RenderRes
     Timer t;  // from the pixel statistics' allocation: first touching them is part of the stage
     PixelStatsImage stats(view.width, view.height);
     Progress progress(label, uint64_t(view.width) * view.height * ctx.spp, !ctx.options.quiet);
+    LightFieldStage initial(ctx.lightField, [&](size_t) { return uint32_t(ctx.spp); });
     result.rays += samplePixels(
         ctx.sampler, stats, view, [&](int, int) { return SampleRange{0, uint32_t(ctx.spp)}; }, false, true,
-        [](int, int, const TracedSample&, int) {}, &progress);
+        [&](int x, int y, const TracedSample& s, int slot) { initial.record(x, y, s, slot); }, &progress);
     progress.done();
     // Pixels at the edge of a visible emitter get topped up, as in every method.
     const Image<uint32_t> topUp = emitterTopUps(stats, kEmitterEdgeSpp);
+    LightFieldStage more(ctx.lightField, [&](size_t p) { return topUp[p]; });
     result.rays += samplePixels(
         ctx.sampler, stats, view,
         [&](int x, int y) { return SampleRange{uint32_t(ctx.spp), topUp(x, y)}; }, false,
-        false, [](int, int, const TracedSample&, int) {}, nullptr);
+        false, [&](int x, int y, const TracedSample& s, int slot) { more.record(x, y, s, slot); }, nullptr);
     storeStats(stats, ctx, result.buffers);
+    finishLightField(ctx, stats);
     result.rays += denseEmission(ctx, topUp, result.buffers);
     stats = PixelStatsImage();
     result.seconds.add("sampling", t.seconds());
@@ -110,7 +155,7 @@ void sampleUniform(const MethodContext& ctx, const std::string& label, RenderRes
 
 void renderMc(const MethodContext& ctx, RenderResult& result) {
     sampleUniform(ctx, "mc sampling", result);
-    result.color = result.buffers.color;
+    result.color = ctx.lightField ? reconstructFromLayers(ctx, {}, result) : result.buffers.color;
 }
 
 RenderResult render(const scene::Scene& scene, const RenderOptions& options) {
@@ -128,7 +173,14 @@ RenderResult render(const scene::Scene& scene, const RenderOptions& options) {
     Timer total;
     Camera camera(desc.camera);
     PathSampler sampler(scene, camera, desc.render.indirect, seed);
-    MethodContext ctx{scene, options, sampler, sampler.view(), spp};
+    // The light field is kept where reconstructing across pixels can change anything: a lens or
+    // motion (without either, every layer is sharp and the result is each pixel's own samples).
+    LightFieldSamples lightField;
+    if (options.layers != "auto" && options.layers != "on" && options.layers != "off")
+        throw Error("--layers", "expected auto, on or off, got '" + options.layers + "'");
+    const bool layered = options.layered() && (camera.hasLens() || desc.hasMotion());
+    if (layered) lightField = LightFieldSamples(desc.camera.width, desc.camera.height);
+    MethodContext ctx{scene, options, sampler, sampler.view(), spp, layered ? &lightField : nullptr};
 
     RenderResult result;
     result.method = options.method;

@@ -42,6 +42,13 @@ struct RenderOptions {
     float atrousSigmaColor = 4.f, atrousSigmaNormal = 0.5f, atrousSigmaPosition = 1.f;
     bool atrousVarianceGuided = true;
     std::string aovDir;              // debug maps (PNG) when non-empty
+    // The layered reconstruction of defocus and motion blur across pixels (filter/layers.h),
+    // where the camera has a lens or the scene moves: "on", "off" (each pixel composes its own
+    // samples by surface, and aaf and maaf apply their defocus filter) or "auto", the measured
+    // better of the two per method: on for mc and atrous, off for aaf and maaf (docs/layers.md).
+    std::string layers = "auto";
+    /// Whether `method` reconstructs with layers under this setting.
+    bool layered() const { return layers == "on" || (layers == "auto" && (method == "mc" || method == "atrous")); }
 };
 
 struct RenderResult {

@@ -6,7 +6,9 @@
 
 #include <atomic>
 #include <cstdint>
+#include <vector>
 
+#include "core/light_field.h"
 #include "core/parallel.h"
 #include "core/progress.h"
 #include "render/pixel_stats.h"
@@ -15,6 +17,33 @@ namespace wedge::render {
 
 struct SampleRange {
     uint32_t first = 0, count = 0;
+};
+
+/// One sampling stage's samples into the light field (render/methods.h, MethodContext::lightField):
+/// made with the stage's sample count per pixel, record() called from samplePixels' sink. Does
+/// nothing without a light field.
+class LightFieldStage {
+public:
+    template <class CountFn>
+    LightFieldStage(LightFieldSamples* lf, CountFn&& count) : m_lf(lf) {
+        if (!m_lf) return;
+        m_stage = m_lf->addStage(count);
+        m_fill.assign(size_t(m_lf->width()) * m_lf->height(), 0);
+    }
+    /// Sample s of pixel (x, y), which PixelStats::add put in surface slot `slot`. Each pixel's
+    /// samples come from one thread, in order.
+    void record(int x, int y, const TracedSample& s, int slot) {
+        if (!m_lf) return;
+        const size_t p = size_t(y) * m_lf->width() + x;
+        const SampleRecord& r = s.record;
+        m_lf->run(m_stage, p)[m_fill[p]++] = LightFieldSample::pack(
+            s.film, r.lens, s.time, s.hit ? s.depth : kInf, s.motion, s.albedo, s.albedo * (r.direct + r.indirect), slot);
+    }
+
+private:
+    LightFieldSamples* m_lf;
+    int m_stage = 0;
+    std::vector<uint32_t> m_fill;
 };
 
 /// range(x, y) -> SampleRange; sink(x, y, const TracedSample&, int slot) with the surface slot

@@ -165,6 +165,7 @@ void Scene::fillHit(const Vec3f& org, const Vec3f& dir, float t, float time, uns
     hit.material = g.materialIds ? g.materialIds[primID] : g.material;
     // Spheres: one surface each; meshes: one per shape.
     hit.object = g.object + (g.sphere ? primID : (g.shapeIds ? g.shapeIds[primID] : 0));
+    hit.displacement = g.sphere ? m_desc.spheres[primID].velocity * m_desc.camera.shutterLength() : g.displacement;
     const Material& m = m_desc.materials[hit.material];
     if (m.map && g.cornerUVs) {
         const Vec2f* uv = g.cornerUVs + 3 * size_t(primID);
@@ -174,9 +175,7 @@ void Scene::fillHit(const Vec3f& org, const Vec3f& dir, float t, float time, uns
         hit.albedo = m.albedo;
     } else {
         // The texture is attached to the object: look it up where the point was at shutter open.
-        const Vec3f displacement =
-            g.sphere ? m_desc.spheres[primID].velocity * m_desc.camera.shutterLength() : g.displacement;
-        hit.albedo = albedoAt(m, hit.position - displacement * time, hit.normal);
+        hit.albedo = albedoAt(m, hit.position - hit.displacement * time, hit.normal);
     }
 }
 

@@ -21,6 +21,7 @@ struct Hit {
     uint32_t material = 0;
     uint32_t object = 0;  // surface id: one per mesh shape (OBJ group) or primitive, one per sphere
     Vec3f albedo;         // the material's, textured at the hit (scene/checker.h)
+    Vec3f displacement{0.f};  // how far the hit object moves over the whole shutter (world)
 };
 
 /// Nearest and farthest occluder distances along a segment (t measured from its origin).

@@ -1,0 +1,153 @@
+// The sampled camera light field: every path sample a render takes, kept compactly with where
+// it was taken on the film, the lens and the shutter (x, y, u, v, t), the depth and screen
+// motion of what it saw, and what it carries (its albedo, its own reflected radiance, and which
+// of its pixel's surfaces it hit). The layered reconstruction (filter/layers.h) reprojects these
+// samples along their defocus and motion trajectories across pixels (Lehtinen et al. 2011,
+// Munkberg et al. 2014).
+//
+// 24 bytes a sample: at 720x720 and 31 spp on average (AAF on conference) 386 MB. Colours are
+// shared-exponent RGB9E5 (9-bit mantissas, one 5-bit exponent: 1/512 of the largest channel),
+// lens and film positions fixed point. Samples are kept per pixel in the order they were taken,
+// in stages (initial, adaptive), so that every pixel's samples and their order depend only on
+// (seed, pixel, sample index), never on the threads.
+#pragma once
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <cstdint>
+#include <vector>
+
+#include "core/image.h"
+#include "core/memory.h"
+
+namespace wedge {
+
+/// RGB9E5: three 9-bit mantissas with a shared 5-bit exponent (bias 15), as in the OpenGL
+/// EXT_texture_shared_exponent format. Non-negative, finite values up to 65408; negative and
+/// non-finite channels are stored as 0.
+inline uint32_t packRgb9e5(const Vec3f& c) {
+    constexpr float kMax = 65408.f;  // (511 / 512) * 2^16
+    auto clampC = [&](float v) { return v > 0.f ? std::min(v, kMax) : 0.f; };  // NaN -> 0
+    const float r = clampC(c.x), g = clampC(c.y), b = clampC(c.z);
+    const float m = std::max({r, g, b});
+    if (!(m > 0.f)) return 0;
+    // The shared exponent e (biased by 15): mantissa = v / 2^(e - 15 - 9), at most 511.
+    int e = std::max(-16, int(std::floor(std::log2(m)))) + 16;
+    float scale = std::ldexp(1.f, 24 - e);
+    if (std::floor(m * scale + 0.5f) >= 512.f) scale = std::ldexp(1.f, 24 - ++e);  // rounding reached 2^9
+    auto mant = [&](float v) { return uint32_t(std::min(511.f, std::floor(v * scale + 0.5f))); };
+    return mant(r) | (mant(g) << 9) | (mant(b) << 18) | (uint32_t(std::min(e, 31)) << 27);
+}
+
+inline Vec3f unpackRgb9e5(uint32_t v) {
+    const float scale = std::bit_cast<float>(uint32_t(int(v >> 27) - 24 + 127) << 23);  // 2^(e - 24)
+    return {float(v & 511u) * scale, float((v >> 9) & 511u) * scale, float((v >> 18) & 511u) * scale};
+}
+
+/// One path sample of the light field.
+struct LightFieldSample {
+    float depth = 0;         // along the camera's forward axis; kInf where the camera ray missed
+    uint32_t albedo = 0;     // RGB9E5
+    uint32_t radiance = 0;   // RGB9E5: its own reflected radiance, albedo (direct + indirect)
+    int16_t lensU = 0, lensV = 0;      // the lens point on the unit disc, x 32767
+    int16_t motionX = 0, motionY = 0;  // screen motion over the whole shutter, 1/8 pixel
+    uint16_t timeSurface = 0;          // shutter time in [0, 1] (14 bits) | surface + 1 (2 bits, 0: none)
+    uint8_t filmX = 0, filmY = 0;      // the position in its pixel, 1/256 pixel
+
+    static constexpr int kNoSurface = -1;
+    static constexpr float kMaxMotion = 4095.f;  // pixels: int16 / 8
+
+    static LightFieldSample pack(Vec2f film, Vec2f lens, float time, float depth, Vec2f motion, const Vec3f& albedo,
+                                 const Vec3f& radiance, int surface) {
+        auto q16 = [](float v, float s, float lim) { return int16_t(std::lround(std::clamp(v, -lim, lim) * s)); };
+        LightFieldSample s;
+        s.depth = depth;
+        s.albedo = packRgb9e5(albedo);
+        s.radiance = packRgb9e5(radiance);
+        s.lensU = q16(lens.x, 32767.f, 1.f);
+        s.lensV = q16(lens.y, 32767.f, 1.f);
+        s.motionX = q16(motion.x, 8.f, kMaxMotion);
+        s.motionY = q16(motion.y, 8.f, kMaxMotion);
+        const uint32_t t = uint32_t(std::lround(std::clamp(time, 0.f, 1.f) * 16383.f));
+        s.timeSurface = uint16_t(t | (uint32_t(std::clamp(surface + 1, 0, 3)) << 14));
+        s.filmX = uint8_t(std::clamp(int(film.x * 256.f), 0, 255));
+        s.filmY = uint8_t(std::clamp(int(film.y * 256.f), 0, 255));
+        return s;
+    }
+    /// The position in the pixel, at the centre of its 1/256 cell.
+    Vec2f film() const { return {(float(filmX) + 0.5f) / 256.f, (float(filmY) + 0.5f) / 256.f}; }
+    Vec2f lens() const { return {float(lensU) / 32767.f, float(lensV) / 32767.f}; }
+    Vec2f motion() const { return {float(motionX) / 8.f, float(motionY) / 8.f}; }
+    float time() const { return float(timeSurface & 0x3fffu) / 16383.f; }
+    /// Which of its pixel's surfaces it hit (a FrameBuffers surface once finish() ran: 0 the
+    /// primary, 1 + k other[k]), or kNoSurface (a miss, or a surface beyond the kept ones).
+    int surface() const { return int(timeSurface >> 14) - 1; }
+    void setSurface(int surface) {
+        timeSurface = uint16_t((timeSurface & 0x3fffu) | (uint32_t(std::clamp(surface + 1, 0, 3)) << 14));
+    }
+    bool hit() const { return depth < kInf; }
+};
+static_assert(sizeof(LightFieldSample) == 24);
+
+/// Every pixel's samples, stage by stage: a stage holds, for each pixel, a run of samples whose
+/// length is fixed when the stage is added (the initial spp, the adaptive counts).
+class LightFieldSamples {
+public:
+    LightFieldSamples() = default;
+    LightFieldSamples(int width, int height) : m_width(width), m_height(height) {}
+
+    int width() const { return m_width; }
+    int height() const { return m_height; }
+    bool empty() const { return m_stages.empty(); }
+
+    /// Adds a stage with count(p) samples for pixel p (row-major index); returns its index.
+    template <class CountFn>
+    int addStage(CountFn&& count) {
+        Stage s;
+        const size_t pixels = size_t(m_width) * m_height;
+        s.offset.resize(pixels + 1);
+        s.offset[0] = 0;
+        for (size_t p = 0; p < pixels; ++p) s.offset[p + 1] = s.offset[p] + count(p);
+        s.samples = LargeVector<LightFieldSample>(s.offset[pixels]);
+        m_stages.push_back(std::move(s));
+        return int(m_stages.size()) - 1;
+    }
+    /// The run of pixel p in stage `stage` (sample k of the stage at [k]).
+    LightFieldSample* run(int stage, size_t p) { return m_stages[stage].samples.data() + m_stages[stage].offset[p]; }
+    uint32_t runLength(int stage, size_t p) const {
+        return uint32_t(m_stages[stage].offset[p + 1] - m_stages[stage].offset[p]);
+    }
+
+    /// fn(const LightFieldSample&) for every sample of pixel p, stage by stage, in order.
+    template <class Fn>
+    void forEach(size_t p, Fn&& fn) const {
+        for (const Stage& s : m_stages)
+            for (uint64_t i = s.offset[p]; i < s.offset[p + 1]; ++i) fn(s.samples[i]);
+    }
+    template <class Fn>
+    void forEachMutable(size_t p, Fn&& fn) {
+        for (Stage& s : m_stages)
+            for (uint64_t i = s.offset[p]; i < s.offset[p + 1]; ++i) fn(s.samples[i]);
+    }
+    size_t count(size_t p) const {
+        size_t n = 0;
+        for (const Stage& s : m_stages) n += s.offset[p + 1] - s.offset[p];
+        return n;
+    }
+    size_t bytes() const {
+        size_t b = 0;
+        for (const Stage& s : m_stages) b += s.samples.size() * sizeof(LightFieldSample) + s.offset.size() * sizeof(uint64_t);
+        return b;
+    }
+
+private:
+    struct Stage {
+        std::vector<uint64_t> offset;  // pixels + 1
+        LargeVector<LightFieldSample> samples;
+    };
+    int m_width = 0, m_height = 0;
+    std::vector<Stage> m_stages;
+};
+
+}  // namespace wedge

@@ -1,0 +1,84 @@
+// Layered reconstruction of the camera's light field across pixels, lens and shutter: defocus and
+// motion blur, with visibility resolved by depth. After Munkberg, Vaidyanathan, Hasselgren,
+// Clarberg and Akenine-Möller 2014 ("Layered Reconstruction for Defocus and Motion Blur": per
+// tile depth layers, samples reprojected to the lens centre at one shutter time, a screen-space
+// filter per layer, layers composited front to back) and Lehtinen, Aila, Chen, Laine and Durand
+// 2011 (samples reprojected along their trajectories; the nearest surface that covers a
+// reconstruction ray is the one it sees).
+//
+// A sample taken at film position x, lens point u and shutter time t on a surface whose
+// defocus slope is c (pixels per unit lens coordinate, ViewGeometry::defocusSlope) and whose
+// screen motion over the shutter is m sees the point that, through the lens centre at mid-shutter,
+// lies at y = x + c u - m (t - 1/2): its position in the layer's "sharp" image (film x along the
+// lens's u, film y downward against its v: y_y = y - c v - m_y (t - 1/2)). Samples of one
+// surface collapse there onto a sharp image, so samples of many pixels can be reused.
+//
+// Per screen tile (64 pixels, with an apron as wide as the trajectories that reach it):
+// 1. The samples are split into depth layers: moving and still samples apart, each sorted by
+//    defocus slope (which falls with depth); a new layer starts where the slopes spread more than
+//    max(0.5, 0.15 |c|) pixels or jump by half a pixel (at most 8 layers, the thresholds widened
+//    until they fit). Layers are composited in the order of their mean inverse depth.
+// 2. Per layer, on a 1-pixel grid in its sharp image: N, the layer's samples at their own y; D,
+//    those and the samples of every layer behind it at the layer's shear y = x + c_l u - m_l (t -
+//    1/2) (c_l, m_l its means); W, R, G, B, its samples' radiance at their own y, in 8 bins of
+//    shutter time for a moving layer (a moving surface's shading changes as it moves); and the
+//    sum of its samples' slopes. A sample in front of the layer tells nothing about it, so it is
+//    left out of D: alpha = N / D is the layer's coverage where it is not hidden. The grids are
+//    smoothed with a Gaussian of sigma = clamp(0.15 |c_l|, 0.5, 2) pixels (at least half the
+//    slopes' spread); cells without weight (the layer hidden there) are filled from their
+//    neighbours. A layer whose true blur (a disc of radius |c|, a segment of length |m|) is
+//    below the grid's own is "sharp": not reprojected, its grid its pixels' own samples.
+// 3. Each pixel is the mean of 32 reconstruction rays (x, y, u, v, t), a 5D Kronecker sequence
+//    shifted per pixel, so that pixel, lens and shutter are stratified jointly. Front to back, a
+//    ray takes each layer's alpha and premultiplied radiance at its shear, with the slope of the
+//    surface it finds there (one fixed-point step: a slanted floor's slope changes across the
+//    tile), narrowed so that the grid's own blur (cells, Gaussian, bilinear lookup) and the
+//    narrowed disc have the second moment of the true disc: C += T alpha L, T *= 1 - alpha.
+//    Light the layers leave uncovered (a hole no sample saw) is the mean of what they cover.
+//    Where every layer of the tile is sharp, one ray at the pixel gives the same: the pixel's
+//    own samples composited by surface, as without layers.
+//
+// The radiance a sample carries is its surface's light as the method filtered it (AAF's or
+// MAAF's filtered direct and indirect light of the sample's surface in its pixel, times the
+// sample's own albedo) or, without filtered light, its own. Emitted light is not reconstructed
+// here: the caller adds each pixel's own (densely sampled at emitter edges).
+#pragma once
+
+#include <array>
+#include <cstdint>
+
+#include "core/buffers.h"
+#include "core/light_field.h"
+
+namespace wedge::filter {
+
+struct LayerOptions {
+    int tile = 64;             // pixels
+    int maxReach = 48;         // pixels: a sample's trajectory is followed at most this far (the cost bound)
+    float sigmaScale = 0.15f;  // the sharp image's Gaussian: sigmaScale |c_l|, clamped to [sigmaMin, sigmaMax]
+    float sigmaMin = 0.5f, sigmaMax = 2.f;
+    float splitMin = 0.5f, splitScale = 0.15f;  // a layer's slopes spread at most max(splitMin, splitScale |c|)
+    int maxLayers = 8;
+    int rays = 32;      // reconstruction rays per pixel where a tile has a blurred layer
+    uint32_t seed = 0;  // of the reconstruction rays
+};
+
+struct LayerInput {
+    const LightFieldSamples& samples;
+    ViewGeometry view;
+    /// The filtered demodulated light of each FrameBuffers surface (0: the primary, 1 + k:
+    /// other[k]); a sample on surface k of pixel p carries albedo x (*surfaceLight[k])[p]. Null:
+    /// the samples on that surface carry their own radiance.
+    std::array<const Image3f*, 1 + FrameBuffers::kOtherSurfaces> surfaceLight{};
+};
+
+struct LayerStats {
+    double gatheredPerPixel = 0;  // samples a tile read, per pixel of the image
+    double layersPerTile = 0;
+    double blurredTiles = 0;      // fraction of tiles with a reprojected (blurred) layer
+};
+
+/// The reflected radiance (no emission) of every pixel, reconstructed from the light field.
+Image3f reconstructLayers(const LayerInput& input, const LayerOptions& options = {}, LayerStats* stats = nullptr);
+
+}  // namespace wedge::filter

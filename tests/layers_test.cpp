@@ -1,0 +1,302 @@
+// The layered reconstruction of defocus and motion blur (filter/layers.h): a constant light field
+// stays constant (also beside tiles without samples), a defocused edge against the thin lens's
+// closed form, a moving square against its shutter average, a scene without defocus and motion
+// as without layers, determinism across thread counts, and the light field's compact sample.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <random>
+
+#include "core/error.h"
+#include "core/light_field.h"
+#include "core/parallel.h"
+#include "filter/layers.h"
+#include "metrics/metrics.h"
+#include "render/camera.h"
+#include "render/renderer.h"
+#include "scene/scene.h"
+#include "scene/scene_loader.h"
+
+using namespace wedge;
+
+namespace {
+
+scene::SceneDesc parse(const std::string& json) { return scene::parseScene(json, "test.json", "."); }
+
+render::RenderResult renderJson(const std::string& json, render::RenderOptions o) {
+    scene::Scene s(parse(json));
+    o.quiet = true;
+    return render::render(s, o);
+}
+
+/// The share of the unit disc with u_x > d: a circular segment.
+double discShareBeyond(double d) {
+    if (d <= -1) return 1;
+    if (d >= 1) return 0;
+    return (std::acos(d) - d * std::sqrt(1 - d * d)) / kPi;
+}
+
+}  // namespace
+
+TEST(LightField, SharedExponentColoursRoundTrip) {
+    std::mt19937 rng(3);
+    std::uniform_real_distribution<float> mantissa(0.f, 1.f), exponent(-12.f, 12.f);
+    for (int i = 0; i < 10000; ++i) {
+        const Vec3f c(mantissa(rng) * std::exp2(exponent(rng)), mantissa(rng) * std::exp2(exponent(rng)),
+                      mantissa(rng) * std::exp2(exponent(rng)));
+        const Vec3f d = unpackRgb9e5(packRgb9e5(c));
+        const float tolerance = maxComponent(c) / 256.f;  // 9-bit mantissas of the largest channel
+        for (int k = 0; k < 3; ++k) EXPECT_NEAR(d[k], c[k], tolerance) << c[k];
+    }
+    EXPECT_EQ(unpackRgb9e5(packRgb9e5(Vec3f(0.f))), Vec3f(0.f));
+    EXPECT_EQ(unpackRgb9e5(packRgb9e5(Vec3f(-1.f, std::nanf(""), 0.f))), Vec3f(0.f));
+    EXPECT_EQ(unpackRgb9e5(packRgb9e5(Vec3f(1.f, 0.5f, 0.25f))), Vec3f(1.f, 0.5f, 0.25f));  // exact in 9 bits
+    EXPECT_NEAR(unpackRgb9e5(packRgb9e5(Vec3f(1e9f))).x, 65408.f, 1.f);                   // clamped to the largest
+}
+
+TEST(LightField, APackedSampleKeepsItsCoordinates) {
+    const LightFieldSample s = LightFieldSample::pack({0.3f, 0.7f}, {-0.5f, 0.25f}, 0.6f, 3.5f, {12.5f, -3.25f},
+                                                      Vec3f(0.5f), Vec3f(0.2f), 2);
+    EXPECT_NEAR(s.film().x, 0.3f, 1.f / 256);
+    EXPECT_NEAR(s.film().y, 0.7f, 1.f / 256);
+    EXPECT_NEAR(s.lens().x, -0.5f, 1e-4f);
+    EXPECT_NEAR(s.lens().y, 0.25f, 1e-4f);
+    EXPECT_NEAR(s.time(), 0.6f, 1e-4f);
+    EXPECT_EQ(s.depth, 3.5f);
+    EXPECT_EQ(s.motion().x, 12.5f);
+    EXPECT_EQ(s.motion().y, -3.25f);
+    EXPECT_EQ(s.surface(), 2);
+    LightFieldSample t = s;
+    t.setSurface(LightFieldSample::kNoSurface);
+    EXPECT_EQ(t.surface(), -1);
+    EXPECT_NEAR(t.time(), 0.6f, 1e-4f);
+}
+
+TEST(Layers, AConstantLightFieldStaysConstantAndEmptyTilesGiveNoNaN) {
+    // Two depths under a wide lens (slopes +10 and -4 px) and a moving third, every sample of
+    // radiance 0.5; the pixels right of x = 128 have no samples at all (two whole 64-px tiles).
+    const int W = 192, H = 80;
+    ViewGeometry view;
+    view.width = W;
+    view.height = H;
+    view.focalPixels = 100;
+    view.apertureRadius = 0.1f;
+    view.focusDistance = 2.f;
+    LightFieldSamples lf(W, H);
+    const int stage = lf.addStage([&](size_t p) { return int(p % W) < 128 ? 16u : 0u; });
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<float> uni(0.f, 1.f);
+    for (int y = 0; y < H; ++y)
+        for (int x = 0; x < 128; ++x) {
+            LightFieldSample* run = lf.run(stage, size_t(y) * W + x);
+            for (int k = 0; k < 16; ++k) {
+                const bool front = (x - 40) * (x - 40) + (y - 40) * (y - 40) < 400;
+                const bool moving = !front && x > 90;
+                const float depth = front ? 1.f : moving ? 1.5f : 10.f;
+                const Vec2f motion = moving ? Vec2f{30.f, 4.f} : Vec2f{0.f, 0.f};
+                run[k] = LightFieldSample::pack({uni(rng), uni(rng)}, concentricDisc(uni(rng), uni(rng)), uni(rng), depth,
+                                                motion, Vec3f(1.f), Vec3f(0.5f), front ? 0 : 1);
+            }
+        }
+    filter::LayerStats stats;
+    const Image3f out = filter::reconstructLayers(filter::LayerInput{lf, view, {}}, filter::LayerOptions{}, &stats);
+    EXPECT_GT(stats.layersPerTile, 1.0);
+    EXPECT_GT(stats.blurredTiles, 0.0);
+    for (int y = 0; y < H; ++y)
+        for (int x = 0; x < W; ++x) {
+            const Vec3f c = out(x, y);
+            ASSERT_TRUE(isFinite(c)) << x << ", " << y;
+            if (x < 100) {
+                EXPECT_NEAR(c.x, 0.5f, 1e-3f) << x << ", " << y;
+            }
+        }
+}
+
+namespace {
+
+/// A lit half-plane (x < 0 at depth 2) in front of nothing, under a thin lens focused at 4: its
+/// edge is blurred by a circle of confusion of radius c = A f (1/2 - 1/4) pixels. The light,
+/// large and far behind the camera, lights the half-plane evenly.
+const char* kDefocusedEdge = R"({
+  "camera": {"position": [0, 0, 0], "look_at": [0, 0, -1], "up": [0, 1, 0], "fov_y": 20, "resolution": [96, 24],
+             "aperture_radius": 0.5, "focus_distance": 4},
+  "materials": {"white": {"albedo": [0.8, 0.8, 0.8]}},
+  "lights": [{"type": "parallelogram", "corner": [-100, -100, 60], "edge1": [0, 200, 0], "edge2": [200, 0, 0], "radiance": [1, 1, 1]}],
+  "objects": [{"type": "quad", "corner": [-10, -10, -2], "edge1": [10, 0, 0], "edge2": [0, 20, 0], "material": "white"}],
+  "render": {"spp": 16, "seed": 2, "indirect": false}
+})";
+
+}  // namespace
+
+TEST(Layers, ADefocusedEdgeMatchesTheThinLensClosedForm) {
+    render::RenderOptions o;
+    o.method = "mc";
+    const render::RenderResult on = renderJson(kDefocusedEdge, o);
+    o.layers = "off";
+    const render::RenderResult off = renderJson(kDefocusedEdge, o);
+    const render::Camera cam(parse(kDefocusedEdge).camera);
+    const double c = 0.5 * cam.focalPixels() * (1.0 / 2.0 - 1.0 / 4.0);  // pixels per unit lens coordinate
+    ASSERT_GT(c, 5.0);
+    // The half-plane's radiance, from its fully covered pixels (far left) without layers.
+    double radiance = 0;
+    int n = 0;
+    for (int y = 0; y < 24; ++y)
+        for (int x = 0; x < 12; ++x) radiance += off.color(x, y).y, ++n;
+    radiance /= n;
+    ASSERT_GT(radiance, 0.01);
+    // Film column x sees the half-plane through lens point u where x + c u_x < e (e = 48, the
+    // edge's pinhole image): a share discShareBeyond((x - e) / c) of the lens, averaged over the
+    // pixel's width.
+    double worstColumn = 0, rmsOn = 0, rmsOff = 0;
+    for (int x = 0; x < 96; ++x) {
+        double expected = 0;
+        for (int k = 0; k < 64; ++k) expected += discShareBeyond((x + (k + 0.5) / 64 - 48.0) / c) / 64;
+        expected *= radiance;
+        double column = 0;
+        for (int y = 0; y < 24; ++y) {
+            column += on.color(x, y).y / 24;
+            rmsOn += sqr(on.color(x, y).y - expected);
+            rmsOff += sqr(off.color(x, y).y - expected);
+        }
+        worstColumn = std::max(worstColumn, std::abs(column - expected) / radiance);
+    }
+    EXPECT_LT(worstColumn, 0.03) << "the largest difference of a column's mean from the closed form, of the plane's radiance";
+    EXPECT_LT(rmsOn, 0.25 * rmsOff) << "pixel by pixel, the layers' squared error against the Monte Carlo estimate's";
+}
+
+TEST(Layers, AMovingSquareIsItsShutterAverage) {
+    // A lit strip 0.2 wide at depth 4 moving 0.6 to the right over nothing (pinhole): a pixel is
+    // the strip's radiance times the share of the shutter the strip covers it.
+    const std::string moving = R"({
+      "camera": {"position": [0, 0, 0], "look_at": [0, 0, -1], "up": [0, 1, 0], "fov_y": 10, "resolution": [64, 16]},
+      "materials": {"white": {"albedo": [0.8, 0.8, 0.8]}},
+      "lights": [{"type": "parallelogram", "corner": [-100, -100, 60], "edge1": [0, 200, 0], "edge2": [200, 0, 0], "radiance": [1, 1, 1]}],
+      "objects": [{"type": "quad", "corner": [-0.4, -1, -4], "edge1": [0.2, 0, 0], "edge2": [0, 2, 0], "material": "white",
+                   "velocity": [0.6, 0, 0]}],
+      "render": {"spp": 16, "seed": 11, "indirect": false}
+    })";
+    render::RenderOptions o;
+    o.method = "mc";
+    const render::RenderResult on = renderJson(moving, o);
+    o.layers = "off";
+    const render::RenderResult off = renderJson(moving, o);
+    std::string still = moving;
+    still.replace(still.find("\"velocity\": [0.6, 0, 0]"), 23, "\"velocity\": [0, 0, 0]");
+    o.spp = 64;
+    const render::RenderResult flat = renderJson(still, o);
+    const render::Camera cam(parse(moving).camera);
+    double radiance = 0;  // the still strip's, at its middle column
+    const float mid = cam.project({-0.3f, 0.f, -4.f}).x;
+    for (int y = 0; y < 16; ++y) radiance += flat.color(int(mid), y).y / 16;
+    ASSERT_GT(radiance, 0.01);
+    auto covered = [&](double x) {  // the share of the shutter during which the strip covers x
+        const double s0 = std::max(0.0, (x + 0.4 - 0.2) / 0.6), s1 = std::min(1.0, (x + 0.4) / 0.6);
+        return std::max(0.0, s1 - s0);
+    };
+    // Each sample's own radiance carries the noise of its light sample, so the shape is checked on
+    // column means (16 pixels of 16 samples) and the pixels' error against Monte Carlo's.
+    double worst = 0, errOn = 0, errOff = 0;
+    for (int x = 0; x < 64; ++x) {
+        double expected = 0, column = 0;
+        for (int k = 0; k < 16; ++k) {
+            const render::Ray ray = cam.generate(x + (k + 0.5f) / 16, 8.f, {0, 0});
+            expected += covered(double(ray.direction.x) * -4.0 / ray.direction.z) / 16;
+        }
+        expected *= radiance;
+        for (int y = 0; y < 16; ++y) {
+            column += on.color(x, y).y / 16;
+            errOn += sqr(on.color(x, y).y - expected);
+            errOff += sqr(off.color(x, y).y - expected);
+        }
+        worst = std::max(worst, std::abs(column - expected) / radiance);
+    }
+    EXPECT_LT(worst, 0.04) << "the largest difference of a column's mean, of the strip's radiance";
+    EXPECT_LT(errOn, 0.2 * errOff) << "the layers' squared error against the Monte Carlo estimate's";
+}
+
+TEST(Layers, WithoutDefocusAndMotionTheImageIsTheOneWithoutLayers) {
+    // A pinhole and nothing moving: nothing to reconstruct across pixels, bit for bit.
+    const std::string json = R"({
+      "camera": {"position": [0, 1.2, 2.2], "look_at": [0, 0.3, 0], "up": [0, 1, 0], "fov_y": 40, "resolution": [32, 32]},
+      "materials": {"grey": {"albedo": [0.6, 0.6, 0.6]}, "red": {"albedo": [0.7, 0.2, 0.1]}},
+      "lights": [{"type": "parallelogram", "corner": [-0.4, 2, -0.4], "edge1": [0.8, 0, 0], "edge2": [0, 0, 0.8], "radiance": [20, 20, 20]}],
+      "objects": [{"type": "quad", "corner": [-3, 0, 3], "edge1": [6, 0, 0], "edge2": [0, 0, -6], "material": "grey"},
+                  {"type": "box", "min": [-0.5, 0.4, -0.1], "max": [0.5, 0.45, 0.1], "material": "red"}],
+      "render": {"spp": 16, "seed": 5, "indirect": true}
+    })";
+    for (const char* method : {"mc", "aaf", "maaf", "atrous"}) {
+        render::RenderOptions o;
+        o.method = method;
+        o.layers = "on";
+        const render::RenderResult on = renderJson(json, o);
+        o.layers = "off";
+        const render::RenderResult off = renderJson(json, o);
+        EXPECT_EQ(0, std::memcmp(on.color.data(), off.color.data(), on.color.size() * sizeof(Vec3f))) << method;
+        EXPECT_FALSE(on.figure("layers_sample_bytes").has_value()) << method;
+    }
+}
+
+TEST(Layers, AnInFocusSceneUnderALensIsTheImageWithoutLayersWithinNoise) {
+    // A textured wall in the plane of focus: every layer is sharp (its pixels' own samples).
+    const std::string json = R"({
+      "camera": {"position": [0, 0, 0], "look_at": [0, 0, -1], "up": [0, 1, 0], "fov_y": 30, "resolution": [32, 32],
+                 "aperture_radius": 0.05, "focus_distance": 3},
+      "materials": {"tiles": {"albedo": [0.8, 0.6, 0.4], "texture": "checker", "texture_scale": 4}},
+      "lights": [{"type": "parallelogram", "corner": [-1, 1, -1], "edge1": [2, 0, 0], "edge2": [0, 0, -1], "radiance": [5, 5, 5]}],
+      "objects": [{"type": "quad", "corner": [-3, -3, -3], "edge1": [6, 0, 0], "edge2": [0, 6, 0], "material": "tiles"}],
+      "render": {"spp": 16, "seed": 9, "indirect": false}
+    })";
+    for (const char* method : {"mc", "aaf"}) {
+        render::RenderOptions o;
+        o.method = method;
+        o.layers = "on";
+        const render::RenderResult on = renderJson(json, o);
+        ASSERT_TRUE(on.figure("layers_sample_bytes").has_value());
+        o.layers = "off";
+        const render::RenderResult off = renderJson(json, o);
+        EXPECT_LT(metrics::compare(on.color, off.color).relMse, 1e-6) << method;
+    }
+}
+
+TEST(Layers, ImageIsBitIdenticalOnOneAndTwoThreads) {
+    for (const char* method : {"mc", "aaf", "maaf", "atrous"}) {
+        render::RenderOptions o;
+        o.method = method;
+        o.spp = 8;
+        o.quiet = true;
+        o.layers = "on";
+        scene::Scene s(parse(kDefocusedEdge));
+        render::RenderResult r1, r2;
+        {
+            ThreadLimit one(1);
+            r1 = render::render(s, o);
+        }
+        {
+            ThreadLimit two(2);
+            r2 = render::render(s, o);
+        }
+        ASSERT_TRUE(r1.figure("layers_sample_bytes").has_value());
+        EXPECT_EQ(0, std::memcmp(r1.color.data(), r2.color.data(), r1.color.size() * sizeof(Vec3f))) << method;
+    }
+}
+
+TEST(Layers, AutoReconstructsForMonteCarloAndAtrousAndABadValueIsAnError) {
+    for (const char* method : {"mc", "aaf", "maaf", "atrous"}) {
+        render::RenderOptions o;
+        o.method = method;
+        o.spp = 4;
+        const render::RenderResult r = renderJson(kDefocusedEdge, o);
+        const bool expected = std::string(method) == "mc" || std::string(method) == "atrous";
+        EXPECT_EQ(r.figure("layers_sample_bytes").has_value(), expected) << method;
+    }
+    render::RenderOptions o;
+    o.layers = "maybe";
+    scene::Scene s(parse(kDefocusedEdge));
+    try {
+        render::render(s, o);
+        FAIL() << "no error for --layers maybe";
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("--layers"), std::string::npos) << e.what();
+    }
+}
