@@ -328,12 +328,15 @@ TEST(Render, DefaultSamplesPerPixel) {
 }
 
 TEST(Render, ImageIsBitIdenticalOnOneAndTwoThreads) {
-    for (const char* method : {"mc", "aaf", "maaf", "atrous"}) {
+    // The plane, and the plank under a lens through the layered reconstruction (filter/layers.h).
+    for (const char* method : {"mc", "aaf", "maaf", "atrous"})
+    for (const char* json : {kPlaneScene, kPlankUnderLens}) {
         render::RenderOptions o;
         o.quiet = true;
         o.method = method;
         o.spp = 8;
-        scene::Scene s(parse(kPlaneScene));
+        o.layers = json == kPlankUnderLens ? "on" : "auto";
+        scene::Scene s(parse(json));
         render::RenderResult r1, r2;
         {
             ThreadLimit one(1);
@@ -344,6 +347,7 @@ TEST(Render, ImageIsBitIdenticalOnOneAndTwoThreads) {
             r2 = render::render(s, o);
         }
         ASSERT_EQ(r1.color.size(), r2.color.size());
+        EXPECT_EQ(r1.figure("layers_sample_bytes").has_value(), json == kPlankUnderLens);
         EXPECT_EQ(0, std::memcmp(r1.color.data(), r2.color.data(), r1.color.size() * sizeof(Vec3f))) << method;
         EXPECT_EQ(0, std::memcmp(r1.buffers.direct.data(), r2.buffers.direct.data(), r1.color.size() * sizeof(Vec3f)));
     }
