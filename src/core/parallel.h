@@ -1,6 +1,7 @@
 // Parallel loops over image tiles with oneTBB. The thread count is set once per process by
 // ThreadLimit (tbb::global_control); results never depend on it because every reduction that
-// reaches an image is either per pixel or done in a fixed order.
+// reaches an image is either per pixel or done in a fixed order. Each block of rows or tiles
+// first checks for cancellation (core/cancel.h), which oneTBB carries to the loop's caller.
 #pragma once
 
 #include <functional>
@@ -9,6 +10,8 @@
 #include <tbb/blocked_range2d.h>
 #include <tbb/global_control.h>
 #include <tbb/parallel_for.h>
+
+#include "core/cancel.h"
 
 namespace wedge {
 
@@ -27,6 +30,7 @@ template <class Body>
 void parallelTiles(int width, int height, int tile, Body&& body) {
     tbb::parallel_for(tbb::blocked_range2d<int>(0, height, tile, 0, width, tile),
                       [&](const tbb::blocked_range2d<int>& r) {
+                          throwIfCancelled();
                           body(r.cols().begin(), r.cols().end(), r.rows().begin(), r.rows().end());
                       });
 }
@@ -35,6 +39,7 @@ void parallelTiles(int width, int height, int tile, Body&& body) {
 template <class Body>
 void parallelRows(int height, Body&& body) {
     tbb::parallel_for(tbb::blocked_range<int>(0, height, 4), [&](const tbb::blocked_range<int>& r) {
+        throwIfCancelled();
         for (int y = r.begin(); y < r.end(); ++y) body(y);
     });
 }

@@ -2,6 +2,8 @@
 
 #include <cstdio>
 
+#include "core/cancel.h"
+
 namespace wedge {
 
 Progress::Progress(std::string label, uint64_t total, bool enabled)
@@ -10,6 +12,7 @@ Progress::Progress(std::string label, uint64_t total, bool enabled)
 Progress::~Progress() { done(); }
 
 void Progress::add(uint64_t units) {
+    throwIfCancelled();
     uint64_t d = m_done.fetch_add(units) + units;
     if (!m_enabled) return;
     double now = m_timer.seconds();

@@ -1,6 +1,7 @@
 // A progress bar with ETA on stderr. Work units are added from any thread; redrawing is
 // rate-limited and done by whichever thread crosses the next redraw time. Silent when disabled
-// (--quiet) or when stderr is not wanted.
+// (--quiet) or when stderr is not wanted. add() is also where a cancelled render stops
+// (core/cancel.h).
 #pragma once
 
 #include <atomic>
