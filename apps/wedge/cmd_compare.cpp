@@ -39,19 +39,6 @@ constexpr float kHeatLo = -4.f, kHeatHi = 0.f;
 // Bias heat maps: the squared bias is a part of the error, so one decade lower.
 constexpr float kBiasHeatLo = -5.f, kBiasHeatHi = -1.f;
 
-/// Every metric of an image with a NaN or infinite pixel is NaN or meaningless (relMSE printed
-/// "nan" and exited 0): name the file, the count and the first such pixel instead.
-void requireFinite(const Image3f& img, const std::string& path) {
-    size_t bad = 0, first = 0;
-    for (size_t i = 0; i < img.size(); ++i)
-        if (!isFinite(img[i]) && bad++ == 0) first = i;
-    if (bad > 0)
-        throw Error(path, std::to_string(bad) + " of " + std::to_string(img.size()) +
-                              " pixels are not finite (NaN or infinite), the first at x = " +
-                              std::to_string(first % size_t(img.width())) + ", y = " +
-                              std::to_string(first / size_t(img.width())) + "; no metric is defined");
-}
-
 void runCompare(const CompareArgs& a) {
     if (!a.heatmap.empty()) io::checkOutputPath(a.heatmap, {".png"});
     if (!a.biasHeatmap.empty()) {
@@ -60,18 +47,13 @@ void runCompare(const CompareArgs& a) {
         io::checkOutputPath(a.biasHeatmap, {".png"});
     }
     Image3f test = io::readColor(a.test), reference = io::readColor(a.reference);
-    requireFinite(test, a.test);
-    requireFinite(reference, a.reference);
-    if (!test.sameSize(reference))
-        throw Error(a.test, "image size mismatch: " + std::to_string(test.width()) + "x" + std::to_string(test.height()) +
-                                " against " + std::to_string(reference.width()) + "x" +
-                                std::to_string(reference.height()) + " in " + a.reference);
+    metrics::checkComparable(test, a.test, reference, a.reference);
     // The variance part of TEST's error, from a render made alike with another seed.
     std::optional<Image3f> other;
     std::optional<Image1f> variance;
     if (!a.varianceFrom.empty()) {
         other = io::readColor(a.varianceFrom);
-        requireFinite(*other, a.varianceFrom);
+        metrics::requireFinite(*other, a.varianceFrom);
         if (!other->sameSize(test))
             throw Error(a.varianceFrom, "--variance-from: image size " + std::to_string(other->width()) + "x" +
                                             std::to_string(other->height()) + " differs from " + a.test + "'s " +

@@ -8,9 +8,9 @@
 
 #include "apps/wedge/commands.h"
 #include "apps/wedge/common.h"
+#include "apps/wedge/render_flags.h"
 #include "core/error.h"
 #include "core/parallel.h"
-#include "filter/maaf.h"
 #include "render/experiment.h"
 #include "scene/scene.h"
 #include "scene/scene_loader.h"
@@ -96,32 +96,7 @@ void registerExperiment(CLI::App& app) {
     cmd->add_option("--seed", args->seed, "Random seed of the methods (default: the scene's render.seed)")
         ->check(numberIn(0, 4294967295.0));
     cmd->add_option("--threads", args->threads, "Worker threads (0: all cores)")->check(numberIn(0, 1024));
-    render::RenderOptions& r = args->options.base;
-    cmd->add_option("--max-extra-spp", r.maxExtraSpp, "aaf/maaf: cap on adaptive samples per pixel (default 16; the papers use 100)")
-        ->check(numberIn(0, 65536));
-    cmd->add_option("--maaf-components", r.maafComponents, "maaf: filters per 2D/3D subspace (3, 5 or 7; 1: the central, axis-aligned filter alone)")
-        ->check(CLI::IsMember({1, 3, 5, 7}));
-    cmd->add_flag("--maaf-paper-rates", r.maafPaperRates,
-                  "maaf: adaptive samples only at the focal plane (Sec. 6.2), not also where a filter has outer components");
-    cmd->add_flag("!--no-focal-fallback", r.maafFocalFallback,
-                  "maaf: keep all components where the defocus slope changes sign");
-    cmd->add_option("--maaf-radius", r.maafRadius, "maaf: spatial filter window in pixels (default 10)")
-        ->check(CLI::Range(1, filter::kMaafMaxWindowRadius));
-    cmd->add_flag("!--no-maaf-fit", r.maafFit, "maaf: all components everywhere, also where the window cannot hold them");
-    cmd->add_flag("--maaf-keep-records", r.maafKeepRecords,
-                  "maaf: keep every pixel's initial samples instead of tracing the outer-component pixels' again");
-    cmd->add_option("--maaf-weights", r.maafWeights, "maaf: component weights mu_p (sampling, eq10 or unit)")
-        ->check(CLI::IsMember({"sampling", "eq10", "unit"}));
-    cmd->add_option("--atrous-iterations", r.atrousIterations, "atrous: wavelet levels")->check(CLI::Range(1, 10));
-    cmd->add_option("--sigma-color", r.atrousSigmaColor, "atrous: colour edge-stopping sigma")->check(numberIn(1e-6, 1e6));
-    cmd->add_option("--sigma-normal", r.atrousSigmaNormal, "atrous: normal edge-stopping sigma")->check(numberIn(1e-6, 1e6));
-    cmd->add_option("--sigma-position", r.atrousSigmaPosition, "atrous: position edge-stopping sigma (pixel footprints)")
-        ->check(numberIn(1e-6, 1e6));
-    cmd->add_flag("!--no-variance", r.atrousVarianceGuided, "atrous: plain colour edge-stopping instead of variance-guided");
-    cmd->add_option("--layers", r.layers,
-                    "auto (default: on for mc and atrous, off for aaf and maaf), on: the layered reconstruction of "
-                    "defocus and motion blur across pixels, off: each pixel's own samples (and aaf's and maaf's defocus filter)")
-        ->check(CLI::IsMember({"auto", "on", "off"}));
+    addMethodFlags(*cmd, args->options.base);
     cmd->add_flag("-q,--quiet", args->options.quiet, "No progress on stderr and no table on stdout");
     cmd->callback([args] {
         args->options.commandLine = commandLine();

@@ -285,6 +285,27 @@ Image1f log10Map(const Image1f& values, float lo) {
     return out;
 }
 
+void requireFinite(const Image3f& img, const std::string& name) {
+    size_t bad = 0, first = 0;
+    for (size_t i = 0; i < img.size(); ++i)
+        if (!isFinite(img[i]) && bad++ == 0) first = i;
+    if (bad > 0)
+        throw Error(name, std::to_string(bad) + " of " + std::to_string(img.size()) +
+                              " pixels are not finite (NaN or infinite), the first at x = " +
+                              std::to_string(first % size_t(img.width())) + ", y = " +
+                              std::to_string(first / size_t(img.width())) + "; no metric is defined");
+}
+
+void checkComparable(const Image3f& test, const std::string& testName, const Image3f& reference,
+                     const std::string& referenceName) {
+    requireFinite(test, testName);
+    requireFinite(reference, referenceName);
+    if (!test.sameSize(reference))
+        throw Error(testName, "image size mismatch: " + std::to_string(test.width()) + "x" +
+                                  std::to_string(test.height()) + " against " + std::to_string(reference.width()) +
+                                  "x" + std::to_string(reference.height()) + " in " + referenceName);
+}
+
 Metrics compare(const Image3f& test, const Image3f& reference) {
     checkSameSize(test, reference);
     return {relMse(test, reference), smape(test, reference), psnr(test, reference), ssim(test, reference)};

@@ -103,6 +103,14 @@ Image<uint8_t> regionClasses(const RegionPlanes& planes, int edgeRadius = 2);
 std::vector<RegionError> regionErrors(const Image3f& test, const Image3f& reference, const Image<uint8_t>& classes,
                                       float eps = kRelMseEpsilon, const Image1f* variance = nullptr);
 
+/// Every metric of an image with a NaN or infinite pixel is NaN or meaningless: throws
+/// wedge::Error naming `name` (a file), the count and the first such pixel instead.
+void requireFinite(const Image3f& img, const std::string& name);
+/// The checks `wedge compare` (and the Python module's compare()) make before measuring: both
+/// images finite, and of one size (else an Error naming both).
+void checkComparable(const Image3f& test, const std::string& testName, const Image3f& reference,
+                     const std::string& referenceName);
+
 struct Metrics {
     double relMse = 0, smape = 0, psnr = 0, ssim = 0;
 };

@@ -12,9 +12,7 @@ const std::vector<std::string>& outputExtensions() {
     return ext;
 }
 
-void writeOutput(const RenderResult& r, const std::string& path) {
-    std::string e = io::extension(path);
-    if (e != ".exr") return io::writeColor(path, r.color);
+std::vector<io::ExrChannel> exrChannels(const RenderResult& r) {
     // Final colour as R, G, B, then every buffer under its own name (pbrt's GBufferFilm style).
     std::vector<io::ExrChannel> channels;
     const float* c = &r.color[0].x;
@@ -29,7 +27,13 @@ void writeOutput(const RenderResult& r, const std::string& path) {
         else
             for (int k = 0; k < n; ++k) channels.push_back({name + "." + (vector ? xyz[k] : rgb[k]), data + k, n});
     });
-    io::writeExr(path, r.color.width(), r.color.height(), channels);
+    return channels;
+}
+
+void writeOutput(const RenderResult& r, const std::string& path) {
+    std::string e = io::extension(path);
+    if (e != ".exr") return io::writeColor(path, r.color);
+    io::writeExr(path, r.color.width(), r.color.height(), exrChannels(r));
 }
 
 nlohmann::json statsJson(const RenderResult& r, const std::string& sceneName) {
