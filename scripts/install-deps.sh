@@ -8,8 +8,11 @@ packages=(
   libembree-dev libtbb-dev libopenexr-dev libpng-dev libjpeg-dev libtinyobjloader-dev
   nlohmann-json3-dev libcli11-dev libfftw3-dev libgtest-dev libbenchmark-dev
   chromium
+  python3-dev pybind11-dev python3-numpy python3-pytest python3-matplotlib
 )
 # chromium: the headless browser the experiment-report test screenshots (tests/experiment_test.cpp).
+# python3-dev, pybind11-dev: the Python module (python/); numpy for its arrays; pytest runs its
+# tests under ctest; matplotlib draws the figures of examples/.
 # Optional extras: `WEDGE_EXTRAS=1` adds Embree's path tracer used as the throughput peer in bench/.
 if [[ "${WEDGE_EXTRAS:-0}" == 1 ]]; then
   packages+=(embree-tools)
