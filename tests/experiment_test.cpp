@@ -3,9 +3,11 @@
 // input, and the report as headless Chromium shows it (a screenshot that must not be blank).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <regex>
 #include <set>
@@ -157,6 +159,32 @@ TEST(ExperimentCommand, WritesRowsAndASelfContainedReport) {
     EXPECT_NE(html.find("net relMSE"), std::string::npos);
     EXPECT_NE(html.find("bias&sup2;"), std::string::npos);
     EXPECT_NE(html.find("Where the error sits"), std::string::npos);
+    // The convergence plot, an inline SVG of every render: one line per method through its
+    // renders' distinct sample counts (the base spp and the searches' probes), one marker each.
+    std::map<std::string, std::set<int>> rendered;
+    for (const auto& r : rows) {
+        rendered[r["method"]].insert(r["spp"].get<int>());
+        if (r.contains("probes"))
+            for (const auto& p : r["probes"]) rendered[r["method"]].insert(p["spp"].get<int>());
+    }
+    const size_t svgAt = html.find("<h2>Convergence</h2>");
+    ASSERT_NE(svgAt, std::string::npos);
+    const std::string svg = html.substr(html.find("<svg", svgAt), html.find("</svg>", svgAt) - html.find("<svg", svgAt));
+    std::regex polyline("<polyline[^>]*points=\"([^\"]*)\"");
+    std::vector<size_t> points;
+    for (auto it = std::sregex_iterator(svg.begin(), svg.end(), polyline); it != std::sregex_iterator(); ++it) {
+        const std::string list = (*it)[1].str();
+        points.push_back(size_t(std::count(list.begin(), list.end(), ',')));
+    }
+    ASSERT_EQ(rendered.size(), 2u);
+    EXPECT_GT(rendered["mc"].size(), 1u) << "mc was searched";
+    size_t markers = 0;
+    for (size_t k = std::string::npos; (k = svg.find("<circle", k + 1)) != std::string::npos;) ++markers;
+    EXPECT_EQ(markers, rendered["mc"].size() + rendered["atrous"].size());
+    // mc's line comes first (the rows' order); atrous, with one render, has a marker and no line.
+    ASSERT_GE(points.size(), 1u);
+    EXPECT_EQ(points[0], rendered["mc"].size());
+    EXPECT_EQ(points.size(), rendered["atrous"].size() > 1 ? 2u : 1u);
     EXPECT_TRUE(fs::is_regular_file(dir + "/table.md"));
     const std::string table = test::readFile(dir + "/table.md");
     EXPECT_NE(table.find("| where | background | mixed | edge | penumbra | defocused | interior |"), std::string::npos)

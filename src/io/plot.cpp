@@ -147,44 +147,98 @@ void Canvas::text(int x, int y, const std::string& s, const Vec3f& c, int scale)
     }
 }
 
-Image3f renderPlot(const LinePlot& plot, int width, int height) {
-    const Vec3f white(1.f), black(0.f), grey = displayColor(0.85f, 0.85f, 0.85f);
-    Canvas cv(width, height, white);
-    const int left = 70, right = 20, top = 34, bottom = 50;
-    const int pw = width - left - right, ph = height - top - bottom;
-    auto mapX = [&](double x) {
+namespace {
+
+/// Where a LinePlot's frame sits in a width x height picture, how values map into it, and its
+/// ticks with their labels: shared by the raster (renderPlot) and the SVG (svgPlot) drawings.
+struct PlotGeometry {
+    const LinePlot& plot;
+    int width, height;
+    // Log-axis labels as "%g" (0.005, 2e-05) instead of formatTick's two decimals, which print
+    // small decades as 0.00; the raster plots keep formatTick's.
+    bool gLabels = false;
+    static constexpr int left = 70, right = 20, top = 34, bottom = 50;
+    int pw = width - left - right, ph = height - top - bottom;
+
+    double mapX(double x) const {
         double t = plot.logX ? (std::log(x) - std::log(plot.xMin)) / (std::log(plot.xMax) - std::log(plot.xMin))
                              : (x - plot.xMin) / (plot.xMax - plot.xMin);
         return left + t * pw;
-    };
-    auto mapY = [&](double y) {
+    }
+    double mapY(double y) const {
         double t = plot.logY ? (std::log(y) - std::log(plot.yMin)) / (std::log(plot.yMax) - std::log(plot.yMin))
                              : (y - plot.yMin) / (plot.yMax - plot.yMin);
         return top + ph - t * ph;
-    };
-    auto logTicks = [](double lo, double hi) {
+    }
+    static std::vector<double> logTicks(double lo, double hi) {
         std::vector<double> t;
         for (double d = std::pow(10.0, std::floor(std::log10(lo))); d <= hi * 1.0001; d *= 10)
             for (double m : {1.0, 2.0, 5.0})
                 if (m * d >= lo * 0.9999 && m * d <= hi * 1.0001) t.push_back(m * d);
         return t;
-    };
+    }
+    /// (value, label) of the x ticks and of the y ticks.
+    std::vector<std::pair<double, std::string>> xTicks() const {
+        std::vector<double> xt = plot.xTicks;
+        if (xt.empty()) xt = plot.logX ? logTicks(plot.xMin, plot.xMax) : niceTicks(plot.xMin, plot.xMax, 8);
+        std::vector<std::pair<double, std::string>> t;
+        for (size_t i = 0; i < xt.size(); ++i)
+            t.emplace_back(xt[i], i < plot.xTickLabels.size() ? plot.xTickLabels[i] : label(xt[i], plot.logX));
+        return t;
+    }
+    std::vector<std::pair<double, std::string>> yTicks() const {
+        std::vector<std::pair<double, std::string>> t;
+        for (double v : plot.logY ? logTicks(plot.yMin, plot.yMax) : niceTicks(plot.yMin, plot.yMax, 6))
+            t.emplace_back(v, label(v, plot.logY));
+        return t;
+    }
+    std::string label(double v, bool logAxis) const {
+        if (!gLabels || !logAxis) return formatTick(v);
+        char buf[32];
+        std::snprintf(buf, sizeof buf, "%g", v);
+        return buf;
+    }
+};
+
+/// A linear colour as the "#rrggbb" of its display value.
+std::string svgColor(const Vec3f& c) {
+    char buf[8];
+    auto byte = [](float v) { return int(std::lround(255.f * std::clamp(srgbEncode(v), 0.f, 1.f))); };
+    std::snprintf(buf, sizeof buf, "#%02x%02x%02x", byte(c.x), byte(c.y), byte(c.z));
+    return buf;
+}
+
+std::string svgText(const std::string& s) {
+    std::string out;
+    for (char c : s) {
+        if (c == '<') out += "&lt;";
+        else if (c == '>') out += "&gt;";
+        else if (c == '&') out += "&amp;";
+        else if (c == '"') out += "&quot;";
+        else out += c;
+    }
+    return out;
+}
+
+}  // namespace
+
+Image3f renderPlot(const LinePlot& plot, int width, int height) {
+    const Vec3f white(1.f), black(0.f), grey = displayColor(0.85f, 0.85f, 0.85f);
+    Canvas cv(width, height, white);
+    const PlotGeometry g{plot, width, height};
+    const int left = g.left, top = g.top, pw = g.pw, ph = g.ph;
+    auto mapX = [&](double x) { return g.mapX(x); };
+    auto mapY = [&](double y) { return g.mapY(y); };
 
     // Grid, ticks and tick labels.
-    std::vector<double> xt = plot.xTicks;
-    if (xt.empty()) {
-        xt = plot.logX ? logTicks(plot.xMin, plot.xMax) : niceTicks(plot.xMin, plot.xMax, 8);
-    }
-    for (size_t i = 0; i < xt.size(); ++i) {
-        double px = mapX(xt[i]);
+    for (const auto& [v, label] : g.xTicks()) {
+        double px = mapX(v);
         cv.line(px, top, px, top + ph, grey);
-        std::string label = i < plot.xTickLabels.size() ? plot.xTickLabels[i] : formatTick(xt[i]);
         cv.text(int(px) - Canvas::textWidth(label) / 2, top + ph + 8, label, black);
     }
-    for (double v : plot.logY ? logTicks(plot.yMin, plot.yMax) : niceTicks(plot.yMin, plot.yMax, 6)) {
+    for (const auto& [v, label] : g.yTicks()) {
         double py = mapY(v);
         cv.line(left, py, left + pw, py, grey);
-        std::string label = formatTick(v);
         cv.text(left - 8 - Canvas::textWidth(label), int(py) - 3, label, black);
     }
     cv.line(left, top, left, top + ph, black);
@@ -228,6 +282,72 @@ Image3f renderPlot(const LinePlot& plot, int width, int height) {
         }
     }
     return cv.image();
+}
+
+std::string svgPlot(const LinePlot& plot, int width, int height) {
+    const PlotGeometry g{plot, width, height, true};
+    std::string s;
+    char buf[256];
+    auto add = [&](const char* fmt, auto... args) {
+        std::snprintf(buf, sizeof buf, fmt, args...);
+        s += buf;
+    };
+    add("<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"%d\" height=\"%d\" viewBox=\"0 0 %d %d\" "
+        "font-family=\"sans-serif\" font-size=\"11\">\n",
+        width, height, width, height);
+    add("<rect width=\"%d\" height=\"%d\" fill=\"#fff\"/>\n", width, height);
+    for (const auto& [v, label] : g.xTicks()) {
+        const double px = g.mapX(v);
+        add("<line x1=\"%.1f\" y1=\"%d\" x2=\"%.1f\" y2=\"%d\" stroke=\"#ddd\"/>", px, g.top, px, g.top + g.ph);
+        add("<text x=\"%.1f\" y=\"%d\" text-anchor=\"middle\">", px, g.top + g.ph + 16);
+        s += svgText(label) + "</text>\n";
+    }
+    for (const auto& [v, label] : g.yTicks()) {
+        const double py = g.mapY(v);
+        add("<line x1=\"%d\" y1=\"%.1f\" x2=\"%d\" y2=\"%.1f\" stroke=\"#ddd\"/>", g.left, py, g.left + g.pw, py);
+        add("<text x=\"%d\" y=\"%.1f\" text-anchor=\"end\">", g.left - 6, py + 4);
+        s += svgText(label) + "</text>\n";
+    }
+    add("<rect x=\"%d\" y=\"%d\" width=\"%d\" height=\"%d\" fill=\"none\" stroke=\"#000\"/>\n", g.left, g.top, g.pw,
+        g.ph);
+    add("<text x=\"%d\" y=\"20\" text-anchor=\"middle\" font-size=\"14\">", width / 2);
+    s += svgText(plot.title) + "</text>\n";
+    add("<text x=\"%d\" y=\"%d\" text-anchor=\"middle\">", g.left + g.pw / 2, height - 10);
+    s += svgText(plot.xLabel) + "</text>\n";
+    add("<text x=\"6\" y=\"%d\">", g.top - 8);
+    s += svgText(plot.yLabel) + "</text>\n";
+
+    // Data, clipped to the frame; ids unique per plot so that several can share a page.
+    static int plots = 0;
+    const std::string clip = "wedge-plot-clip-" + std::to_string(plots++);
+    add("<clipPath id=\"%s\"><rect x=\"%d\" y=\"%d\" width=\"%d\" height=\"%d\"/></clipPath>\n<g clip-path=\"url(#%s)\">\n",
+        clip.c_str(), g.left, g.top, g.pw, g.ph, clip.c_str());
+    for (const auto& ser : plot.series) {
+        const std::string color = svgColor(ser.color);
+        if (ser.lines && ser.xs.size() > 1) {
+            s += "<polyline fill=\"none\" stroke=\"" + color + "\" stroke-width=\"2\"" +
+                 (ser.dash ? " stroke-dasharray=\"" + std::to_string(ser.dash) + "\"" : "") + " points=\"";
+            for (size_t i = 0; i < ser.xs.size(); ++i) add("%.1f,%.1f ", g.mapX(ser.xs[i]), g.mapY(ser.ys[i]));
+            s += "\"/>\n";
+        }
+        if (ser.marker >= 0)
+            for (size_t i = 0; i < ser.xs.size(); ++i)
+                add("<circle cx=\"%.1f\" cy=\"%.1f\" r=\"3.5\" fill=\"%s\"/>", g.mapX(ser.xs[i]), g.mapY(ser.ys[i]),
+                    color.c_str());
+        s += "\n";
+    }
+    s += "</g>\n";
+    // Legend, top-right inside the frame.
+    int ly = g.top + 14;
+    for (const auto& ser : plot.series) {
+        const int lx = g.left + g.pw - 110;
+        add("<line x1=\"%d\" y1=\"%d\" x2=\"%d\" y2=\"%d\" stroke=\"%s\" stroke-width=\"2\"/>", lx, ly - 4, lx + 24,
+            ly - 4, svgColor(ser.color).c_str());
+        add("<text x=\"%d\" y=\"%d\">", lx + 30, ly);
+        s += svgText(ser.label) + "</text>\n";
+        ly += 15;
+    }
+    return s + "</svg>\n";
 }
 
 Image3f besideEachOther(const std::vector<Image3f>& images, int gap) {

@@ -2,7 +2,7 @@
 // bitmap font, and line plots with linear or logarithmic axes, ticks and a legend, drawn into an
 // Image3f of linear colours for writePng. Used by `wedge analyze` (the spectrum figure, Tables
 // 1-2 and Fig. 6 of Wu et al. 2017) and `wedge raster` (the cache sweep, Fig. 8 of Vaidyanathan
-// et al. 2012).
+// et al. 2012). svgPlot draws the same plots as SVG for `wedge experiment`'s HTML page.
 #pragma once
 
 #include <string>
@@ -59,6 +59,8 @@ struct LinePlot {
 
 /// Renders the plot with its axes, ticks, labels and legend.
 Image3f renderPlot(const LinePlot& plot, int width = 800, int height = 520);
+/// The same plot as an SVG document (text, for inlining in HTML: `wedge experiment`'s page).
+std::string svgPlot(const LinePlot& plot, int width = 640, int height = 420);
 /// Places images side by side (top-aligned) on a white background with a gap.
 Image3f besideEachOther(const std::vector<Image3f>& images, int gap = 16);
 

@@ -13,6 +13,7 @@
 #include "core/parallel.h"
 #include "core/sampler.h"
 #include "io/image_io.h"
+#include "io/plot.h"
 #include "io/text_file.h"
 
 namespace fs = std::filesystem;
@@ -200,6 +201,7 @@ private:
     void writeImages();
     void writeResultsJson() const;
     std::string markdownTable() const;
+    std::string convergenceSvg() const;
     void writeHtml() const;
 
     const scene::Scene& m_scene;
@@ -654,6 +656,45 @@ std::string Experiment::markdownTable() const {
     return os.str();
 }
 
+/// relMSE against total seconds, log-log, for every render the experiment made (base renders and
+/// the searches' probes), one line per method in order of spp: the convergence plot of the
+/// filtering papers, from the experiment's own renders, as an inline SVG.
+std::string Experiment::convergenceSvg() const {
+    io::LinePlot plot;
+    plot.title = m_result.scene + ": relMSE against time";
+    plot.xLabel = "seconds (render total)";
+    plot.yLabel = "relMSE";
+    plot.logX = plot.logY = true;
+    double xLo = INFINITY, xHi = 0, yLo = INFINITY, yHi = 0;
+    std::vector<std::string> order;
+    for (const auto& r : m_result.rows)
+        if (std::find(order.begin(), order.end(), r.method) == order.end()) order.push_back(r.method);
+    for (const auto& method : order) {
+        auto it = m_memo.find(method);
+        if (it == m_memo.end()) continue;
+        io::PlotSeries series;
+        series.label = method;
+        series.marker = 0;
+        // The colours of examples/convergence.py.
+        series.color = method == "mc"     ? io::displayColor(0.27f, 0.27f, 0.27f)
+                       : method == "aaf"  ? io::displayColor(0.12f, 0.47f, 0.71f)
+                       : method == "maaf" ? io::displayColor(0.84f, 0.15f, 0.16f)
+                                          : io::displayColor(0.17f, 0.63f, 0.17f);
+        for (const auto& [spp, p] : it->second) {  // std::map: in order of spp
+            const double t = p.seconds.get("total"), e = p.metrics.relMse;
+            if (!(t > 0 && e > 0)) continue;  // no point on a log axis
+            series.xs.push_back(t);
+            series.ys.push_back(e);
+            xLo = std::min(xLo, t), xHi = std::max(xHi, t), yLo = std::min(yLo, e), yHi = std::max(yHi, e);
+        }
+        if (!series.xs.empty()) plot.series.push_back(std::move(series));
+    }
+    if (plot.series.empty()) return "<p>No render with a positive time and relMSE.</p>";
+    // A margin of a fifth of a decade on each side, wide enough for one point alone.
+    plot.xMin = xLo / 1.6, plot.xMax = xHi * 1.6, plot.yMin = yLo / 1.6, plot.yMax = yHi * 1.6;
+    return io::svgPlot(plot, 640, 420);
+}
+
 void Experiment::writeHtml() const {
     const fs::path out(m_options.outDir);
     auto embed = [&](const std::string& relative) {
@@ -803,6 +844,10 @@ void Experiment::writeHtml() const {
           << embed(r.heatmap) << "\"></figure>\n";
     }
     h << "</div>\n";
+    // Below the images, which stay on the first screen.
+    h << "<h2>Convergence</h2>\n<p>relMSE against total seconds, log-log, of every render this experiment made "
+         "(the base renders and the searches' probes, each at the time it was first measured), in order of spp.</p>\n"
+      << convergenceSvg();
 
     bool searched = false;
     for (const auto& r : m_result.rows) searched |= r.setting != "base";

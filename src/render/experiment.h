@@ -5,7 +5,7 @@
 // found by bisection over the method's integer --spp inside a bracket that a power-law guess
 // (relMSE ~ 1/spp, time ~ a + b spp) and doubling establish. Writes DIR/results.json (a list of
 // rows), DIR/index.html (self-contained: images as base64 PNG, insets, heat maps, the Fig. 12
-// style table), DIR/table.md and the images under DIR/images/. Times are wall-clock stage times
+// style table, the convergence plot of its renders as inline SVG), DIR/table.md and the images under DIR/images/. Times are wall-clock stage times
 // of render(); each probe keeps the fastest of --repeat renders, and the rows of the table are
 // re-timed --repeat more times at the end (the fastest counts), since a shared machine's load
 // comes in bursts.
