@@ -5,7 +5,7 @@ wedge.compare(); time is the render's own total (stats["seconds"]["total"]). A m
 curve lies lower reaches a given error sooner; MC's slope is -1 (relMSE ~ 1/spp ~ 1/seconds).
 
     export PYTHONPATH=$PWD/build/python
-    python3 examples/convergence.py                               # cornell, 128x128 -> convergence.png
+    python3 examples/convergence.py                               # cornell, 256x256 -> convergence.png
     python3 examples/convergence.py --scene grids --spp 2,4,8,16,32 --out grids-convergence.png
 """
 import argparse
@@ -23,11 +23,14 @@ STYLE = {"mc": ("#444444", "o"), "aaf": ("#1f77b4", "s"), "maaf": ("#d62728", "D
 def main():
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     p.add_argument("--scene", default="cornell", help="built-in name or scene file (default cornell)")
-    p.add_argument("--resolution", default="128x128", help="WxH (default 128x128)")
-    p.add_argument("--spp", default="1,2,4,8,16,32", help="comma-separated sample counts (default 1,2,4,8,16,32)")
+    p.add_argument("--resolution", default="256x256", help="WxH (default 256x256)")
+    p.add_argument("--spp", default="1,2,4,8,16,32,64",
+                   help="comma-separated sample counts (default 1,2,4,8,16,32,64)")
     p.add_argument("--methods", default="mc,aaf,maaf,atrous")
     p.add_argument("--reference-spp", type=int, default=1024, help="MC reference samples per pixel (default 1024)")
     p.add_argument("--seed", type=int, default=1)
+    p.add_argument("--repeat", type=int, default=1,
+                   help="renders per point, the fastest counts (as wedge experiment --repeat; timings are noisy)")
     p.add_argument("--out", default="convergence.png", help="output PNG (default convergence.png)")
     a = p.parse_args()
     w, h = (int(v) for v in a.resolution.lower().split("x"))
@@ -41,7 +44,8 @@ def main():
     for m in a.methods.split(","):
         seconds, errors = [], []
         for spp in counts:
-            r = wedge.render(scene, method=m, spp=spp, seed=a.seed, **common)
+            runs = [wedge.render(scene, method=m, spp=spp, seed=a.seed, **common) for _ in range(a.repeat)]
+            r = min(runs, key=lambda run: run.stats["seconds"]["total"])  # the same image each time
             seconds.append(r.stats["seconds"]["total"])
             errors.append(wedge.compare(r, ref)["relmse"])
             print(f"{m:7s} {spp:5d} spp  {seconds[-1]:7.3f} s  relMSE {errors[-1]:.5f}")

@@ -8,7 +8,8 @@ insets enlarged, and each method's per-pixel error map (log10 relative squared e
     python3 examples/methods_side_by_side.py                     # cornell, 256x256 -> methods.png
     python3 examples/methods_side_by_side.py --scene grids --resolution 200x150 --out grids.png
 
-The inset sits where MC errs most (a window of a fifth of the image), unless --inset gives it.
+The inset sits where the three filters together err most (a window of a fifth of the image),
+unless --inset gives it.
 """
 import argparse
 import time
@@ -69,11 +70,12 @@ def main():
         ix, iy, size = (int(v) for v in a.inset.split(","))
     else:
         size = max(4, min(w, h) // 5)
-        ix, iy = worst_window(relative_error(results["mc"].color, ref), size)
+        filtered = sum(relative_error(results[m].color, ref) for m in METHODS if m != "mc")
+        ix, iy = worst_window(filtered, size)
 
     columns = ["reference"] + METHODS
-    fig, axes = plt.subplots(3, len(columns), figsize=(2.4 * len(columns), 2.4 * 3 * max(h / w, 0.6)),
-                             squeeze=False)
+    fig, axes = plt.subplots(3, len(columns), figsize=(2.1 * len(columns), 2.3 * 3 * max(h / w, 0.6)),
+                             squeeze=False, layout="constrained")
     for col, name in enumerate(columns):
         img = ref if name == "reference" else results[name].color
         top, mid, bottom = axes[0, col], axes[1, col], axes[2, col]
@@ -89,7 +91,7 @@ def main():
             top.set_title(f"{name}\n{r.stats['spp_average']:.1f} spp, {r.stats['seconds']['total']:.2f} s", fontsize=9)
             heat = bottom.imshow(np.log10(np.maximum(relative_error(img, ref), 1e-4)), vmin=-4, vmax=0,
                                  cmap="inferno", interpolation="nearest")
-            bottom.set_title(f"relMSE {m['relmse']:.4f}\nPSNR {m['psnr']:.1f} dB, SSIM {m['ssim']:.3f}", fontsize=8)
+            bottom.set_title(f"relMSE {m['relmse']:.3g}\nPSNR {m['psnr']:.1f} dB, SSIM {m['ssim']:.3f}", fontsize=8)
         for ax in (top, mid, bottom):
             ax.set_xticks([])
             ax.set_yticks([])
@@ -98,7 +100,7 @@ def main():
     fig.colorbar(heat, ax=list(axes[2, 1:]), shrink=0.8, ticks=[-4, -3, -2, -1, 0])
     fig.suptitle(f"{scene.name}, {w}x{h}, {a.spp} spp per method (initial spp for aaf and maaf), seed {a.seed}",
                  fontsize=10)
-    fig.savefig(a.out, dpi=100)
+    fig.savefig(a.out, dpi=80)
     print("wrote", a.out)
 
 
