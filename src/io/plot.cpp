@@ -8,6 +8,7 @@
 #include <cstdio>
 
 #include "io/image_io.h"
+#include "io/text_file.h"
 
 namespace wedge::io {
 
@@ -208,18 +209,6 @@ std::string svgColor(const Vec3f& c) {
     return buf;
 }
 
-std::string svgText(const std::string& s) {
-    std::string out;
-    for (char c : s) {
-        if (c == '<') out += "&lt;";
-        else if (c == '>') out += "&gt;";
-        else if (c == '&') out += "&amp;";
-        else if (c == '"') out += "&quot;";
-        else out += c;
-    }
-    return out;
-}
-
 }  // namespace
 
 Image3f renderPlot(const LinePlot& plot, int width, int height) {
@@ -300,22 +289,22 @@ std::string svgPlot(const LinePlot& plot, int width, int height) {
         const double px = g.mapX(v);
         add("<line x1=\"%.1f\" y1=\"%d\" x2=\"%.1f\" y2=\"%d\" stroke=\"#ddd\"/>", px, g.top, px, g.top + g.ph);
         add("<text x=\"%.1f\" y=\"%d\" text-anchor=\"middle\">", px, g.top + g.ph + 16);
-        s += svgText(label) + "</text>\n";
+        s += htmlEscape(label) + "</text>\n";
     }
     for (const auto& [v, label] : g.yTicks()) {
         const double py = g.mapY(v);
         add("<line x1=\"%d\" y1=\"%.1f\" x2=\"%d\" y2=\"%.1f\" stroke=\"#ddd\"/>", g.left, py, g.left + g.pw, py);
         add("<text x=\"%d\" y=\"%.1f\" text-anchor=\"end\">", g.left - 6, py + 4);
-        s += svgText(label) + "</text>\n";
+        s += htmlEscape(label) + "</text>\n";
     }
     add("<rect x=\"%d\" y=\"%d\" width=\"%d\" height=\"%d\" fill=\"none\" stroke=\"#000\"/>\n", g.left, g.top, g.pw,
         g.ph);
     add("<text x=\"%d\" y=\"20\" text-anchor=\"middle\" font-size=\"14\">", width / 2);
-    s += svgText(plot.title) + "</text>\n";
+    s += htmlEscape(plot.title) + "</text>\n";
     add("<text x=\"%d\" y=\"%d\" text-anchor=\"middle\">", g.left + g.pw / 2, height - 10);
-    s += svgText(plot.xLabel) + "</text>\n";
+    s += htmlEscape(plot.xLabel) + "</text>\n";
     add("<text x=\"6\" y=\"%d\">", g.top - 8);
-    s += svgText(plot.yLabel) + "</text>\n";
+    s += htmlEscape(plot.yLabel) + "</text>\n";
 
     // Data, clipped to the frame; ids unique per plot so that several can share a page.
     static int plots = 0;
@@ -344,7 +333,7 @@ std::string svgPlot(const LinePlot& plot, int width, int height) {
         add("<line x1=\"%d\" y1=\"%d\" x2=\"%d\" y2=\"%d\" stroke=\"%s\" stroke-width=\"2\"/>", lx, ly - 4, lx + 24,
             ly - 4, svgColor(ser.color).c_str());
         add("<text x=\"%d\" y=\"%d\">", lx + 30, ly);
-        s += svgText(ser.label) + "</text>\n";
+        s += htmlEscape(ser.label) + "</text>\n";
         ly += 15;
     }
     return s + "</svg>\n";

@@ -19,4 +19,16 @@ std::string readTextFile(const std::string& file) {
     return text.str();
 }
 
+std::string htmlEscape(const std::string& s) {
+    std::string out;
+    for (char c : s) {
+        if (c == '<') out += "&lt;";
+        else if (c == '>') out += "&gt;";
+        else if (c == '&') out += "&amp;";
+        else if (c == '"') out += "&quot;";
+        else out += c;
+    }
+    return out;
+}
+
 }  // namespace wedge::io

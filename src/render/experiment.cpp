@@ -132,17 +132,7 @@ std::string base64(const std::string& bytes) {
     return out;
 }
 
-std::string htmlEscape(const std::string& s) {
-    std::string out;
-    for (char c : s) {
-        if (c == '<') out += "&lt;";
-        else if (c == '>') out += "&gt;";
-        else if (c == '&') out += "&amp;";
-        else if (c == '"') out += "&quot;";
-        else out += c;
-    }
-    return out;
-}
+using io::htmlEscape;
 
 Image3f crop(const Image3f& img, int x0, int y0, int size) {
     Image3f out(size, size);
