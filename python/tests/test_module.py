@@ -113,3 +113,27 @@ def test_write_image_formats(cornell, tmp_path):
 
 def test_error_is_a_value_error():
     assert issubclass(wedge.Error, ValueError)
+
+
+def test_the_gil_is_released_while_rendering(cornell):
+    # A Python thread that notes the time every millisecond: with the GIL held for the whole
+    # render it could note nothing between the render's start and end.
+    import threading
+    import time
+    ticks, stop = [], threading.Event()
+
+    def tick():
+        while not stop.is_set():
+            ticks.append(time.perf_counter())
+            time.sleep(0.001)
+
+    t = threading.Thread(target=tick)
+    t.start()
+    try:
+        start = time.perf_counter()
+        wedge.render(cornell, method="mc", spp=64, resolution=(128, 128), quiet=True)
+        end = time.perf_counter()
+    finally:
+        stop.set()
+        t.join()
+    assert sum(start < x < end for x in ticks) >= 2
