@@ -10,7 +10,10 @@ import sys
 import time
 
 CHILD = r"""
-import sys, wedge
+import signal, sys, wedge
+# Python's own Ctrl-C handler, as an interactive session has it, also where the test runs with
+# SIGINT ignored (a background job of a non-interactive shell), which Python would inherit.
+signal.signal(signal.SIGINT, signal.default_int_handler)
 scene = wedge.load_scene("cornell")
 print("rendering", flush=True)
 try:
