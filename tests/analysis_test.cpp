@@ -397,7 +397,7 @@ TEST(AnalysisPenumbra, ThreeComponentsAreTooHardFiveAndSevenAreNot) {
 }
 
 TEST(AnalysisPenumbra, OuterComponentsTradeNoiseForBias) {
-    // Why MAAF does not beat AAF in renders (README): the outer components cut the noise of the
+    // Why MAAF does not beat AAF in renders (docs/maaf.md): the outer components cut the noise of the
     // axis-aligned filter 3x, but at least double its bias, so they win only below a sample
     // density (measured: 440-570 samples per penumbra width in flatland).
     PenumbraSetup setup;

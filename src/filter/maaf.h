@@ -28,7 +28,7 @@
 // the kernel's argument is -y, so the phase is C_x a - C_y y, which is what is used.
 //
 // Spatial Gaussians are unit-integral, so that component p peaks at mu_p along Omega_x as eq. 9
-// says. Five practical conventions, each measured against a reference (README):
+// says. Five practical conventions, each measured against a reference (docs/maaf.md):
 //  - Weights: eq. 10 weighs component p by a Gaussian over the double wedge, the spectrum of a
 //    Gaussian light of std sqrt(area) / 2. Without eq. 20's windows the light and lens samples
 //    are drawn from the light's and the aperture's own densities, so the kernel over a sample's
@@ -127,7 +127,7 @@ struct MaafOptions {
     float zMinPixels = 10.f;  // clamp of the bounce distance z_min, in pixel sizes (NOTES: scene-scale constant)
     float bandwidthRatio = 3.f;  // reject neighbours whose central width differs by more than this factor
     bool focalFallback = true;
-    // Practical conventions (measured, see the file comment and README):
+    // Practical conventions (measured, see the file comment and docs/maaf.md):
     float spatialScale = 2.449490f;  // Fourier std of the spatial Gaussians = sqrt(6) x the half-width (AAF's kernel)
     float pixelBandwidth = 2.449490f;  // Omega_x never exceeds this / (world size of a pixel)
     bool apertureWindows = false;    // eq. 20's Gaussian windows over the light and the lens
