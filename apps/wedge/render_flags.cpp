@@ -1,3 +1,4 @@
+// The render flags of render_flags.h: their checks and help texts, and the RenderOptions they set.
 #include "apps/wedge/render_flags.h"
 
 #include <filesystem>
