@@ -3,10 +3,14 @@
 #include <gtest/gtest.h>
 #include <zlib.h>
 
+#include <atomic>
 #include <filesystem>
 
+#include "core/cancel.h"
 #include "core/error.h"
 #include "core/image.h"
+#include "core/parallel.h"
+#include "core/progress.h"
 #include "core/sampler.h"
 #include "io/image_io.h"
 #include "test_util.h"
@@ -100,6 +104,34 @@ TEST(Sampler, DependsOnlyOnSeedPixelIndexAndPair) {
     EXPECT_NE(a.get2D(7, 2).x, d.get2D(7, 2).x);
     EXPECT_NE(a.get2D(7, 2).x, a.get2D(7, 3).x);
     EXPECT_EQ(reverseBits32(sobol1Reversed(12345)), sobol1(12345));
+}
+
+// A cancellation request stops the parallel loops and the progress counters, which every stage of
+// a render goes through, with Cancelled; cleared, they run to the end again.
+TEST(Cancel, StopsLoopsAndProgressUntilCleared) {
+    ThreadLimit limit(2);
+    std::atomic<int> rows{0};
+    auto count = [&](int) { ++rows; };
+    requestCancel();
+    EXPECT_THROW(parallelRows(64, count), Cancelled);
+    EXPECT_THROW(parallelTiles(64, 64, 16, [&](int, int, int, int) { ++rows; }), Cancelled);
+    EXPECT_EQ(rows, 0) << "no block starts once cancellation was requested";
+    Progress progress("test", 10, false);
+    EXPECT_THROW(progress.add(1), Cancelled);
+    // Requested midway, the loop stops after the blocks already running.
+    clearCancel();
+    rows = 0;
+    EXPECT_THROW(parallelRows(4096, [&](int y) {
+                     if (y == 0) requestCancel();
+                     ++rows;
+                 }),
+                 Cancelled);
+    EXPECT_LT(rows, 4096);
+    clearCancel();
+    rows = 0;
+    parallelRows(64, count);
+    EXPECT_EQ(rows, 64);
+    progress.add(1);
 }
 
 TEST(Image, FillsAndCopiesEveryPixelOverReusedMemory) {
