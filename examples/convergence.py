@@ -29,6 +29,8 @@ def main():
     p.add_argument("--methods", default="mc,aaf,maaf,atrous")
     p.add_argument("--reference-spp", type=int, default=1024, help="MC reference samples per pixel (default 1024)")
     p.add_argument("--seed", type=int, default=1)
+    p.add_argument("--layers", default="auto", choices=["auto", "on", "off"],
+                   help="the methods' --layers (default auto: on for mc and atrous); the reference is always off")
     p.add_argument("--repeat", type=int, default=1,
                    help="renders per point, the fastest counts (as wedge experiment --repeat; timings are noisy)")
     p.add_argument("--out", default="convergence.png", help="output PNG (default convergence.png)")
@@ -38,13 +40,15 @@ def main():
 
     scene = wedge.load_scene(a.scene)
     common = dict(resolution=(w, h), quiet=True)
-    ref = wedge.render(scene, method="mc", spp=a.reference_spp, seed=a.seed + 1000, **common)
+    # Plain Monte Carlo for the reference (layers off: their smoothing would be a bias at any spp).
+    ref = wedge.render(scene, method="mc", spp=a.reference_spp, seed=a.seed + 1000, layers="off", **common)
 
     fig, ax = plt.subplots(figsize=(6, 4.2))
     for m in a.methods.split(","):
         seconds, errors = [], []
         for spp in counts:
-            runs = [wedge.render(scene, method=m, spp=spp, seed=a.seed, **common) for _ in range(a.repeat)]
+            runs = [wedge.render(scene, method=m, spp=spp, seed=a.seed, layers=a.layers, **common)
+                    for _ in range(a.repeat)]
             r = min(runs, key=lambda run: run.stats["seconds"]["total"])  # the same image each time
             seconds.append(r.stats["seconds"]["total"])
             errors.append(wedge.compare(r, ref)["relmse"])
@@ -57,7 +61,7 @@ def main():
                     fontsize=7, color=color)
     ax.set_xlabel("seconds (render total)")
     ax.set_ylabel("relMSE against MC %d spp" % a.reference_spp)
-    ax.set_title(f"{scene.name}, {w}x{h}: error against time", fontsize=10)
+    ax.set_title(f"{scene.name}, {w}x{h}, layers {a.layers}: error against time", fontsize=10)
     ax.grid(True, which="both", alpha=0.3)
     ax.legend()
     fig.tight_layout()

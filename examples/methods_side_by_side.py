@@ -51,6 +51,8 @@ def main():
     p.add_argument("--spp", type=int, default=8, help="base samples per pixel of every method (default 8)")
     p.add_argument("--reference-spp", type=int, default=1024, help="MC reference samples per pixel (default 1024)")
     p.add_argument("--seed", type=int, default=1)
+    p.add_argument("--layers", default="auto", choices=["auto", "on", "off"],
+                   help="the methods' --layers (default auto: on for mc and atrous); the reference is always off")
     p.add_argument("--inset", help="x,y,size of the inset in pixels (default: where MC errs most)")
     p.add_argument("--out", default="methods.png", help="output PNG (default methods.png)")
     a = p.parse_args()
@@ -58,12 +60,14 @@ def main():
 
     scene = wedge.load_scene(a.scene)
     common = dict(seed=a.seed, resolution=(w, h), quiet=True)
-    # The reference gets its own seed, so that its noise is independent of the methods'.
-    ref = wedge.render(scene, method="mc", spp=a.reference_spp, **{**common, "seed": a.seed + 1000}).color
+    # The reference: plain Monte Carlo (the layered reconstruction's smoothing would be a bias at
+    # any spp) with its own seed, so that its noise is independent of the methods'.
+    ref = wedge.render(scene, method="mc", spp=a.reference_spp, layers="off",
+                       **{**common, "seed": a.seed + 1000}).color
     results = {}
     for m in METHODS:
         t0 = time.perf_counter()
-        results[m] = wedge.render(scene, method=m, spp=a.spp, **common)
+        results[m] = wedge.render(scene, method=m, spp=a.spp, layers=a.layers, **common)
         print(f"{m:7s} {time.perf_counter() - t0:6.2f} s  {wedge.compare(results[m], ref)}")
 
     if a.inset:
@@ -98,7 +102,8 @@ def main():
     axes[1, 0].set_ylabel("inset", fontsize=9)
     axes[2, 1].set_ylabel("log10 rel. sq. error", fontsize=8)
     fig.colorbar(heat, ax=list(axes[2, 1:]), shrink=0.8, ticks=[-4, -3, -2, -1, 0])
-    fig.suptitle(f"{scene.name}, {w}x{h}, {a.spp} spp per method (initial spp for aaf and maaf), seed {a.seed}",
+    fig.suptitle(f"{scene.name}, {w}x{h}, {a.spp} spp per method (initial spp for aaf and maaf), seed {a.seed}, "
+                 f"layers {a.layers}",
                  fontsize=10)
     fig.savefig(a.out, dpi=80)
     print("wrote", a.out)

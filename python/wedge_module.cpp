@@ -42,13 +42,14 @@ struct Result {
 };
 
 /// A keyword as the flag it stands for: max_extra_spp=32 -> "--max-extra-spp=32", True/False ->
-/// "=true"/"=false" (CLI11 reads both for flags and negated flags), resolution=(W, H) -> "WxH".
+/// "=on"/"=off" (CLI11 reads both for flags and negated flags, and they are the values of on/off
+/// options such as --layers), resolution=(W, H) -> "WxH".
 std::string keywordFlag(const std::string& key, const py::handle& value) {
     std::string flag = "--" + key;
     std::replace(flag.begin(), flag.end(), '_', '-');
     std::string text;
     if (py::isinstance<py::bool_>(value))
-        text = value.cast<bool>() ? "true" : "false";
+        text = value.cast<bool>() ? "on" : "off";
     else if (key == "resolution" && (py::isinstance<py::tuple>(value) || py::isinstance<py::list>(value))) {
         py::sequence wh = value.cast<py::sequence>();
         if (wh.size() != 2) throw Error("--resolution " + std::string(py::str(value)), "expected (W, H)");

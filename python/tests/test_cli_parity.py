@@ -63,6 +63,7 @@ BAD_OPTIONS = [
     (dict(maaf_weights="flat"), ["--maaf-weights", "flat"]),
     (dict(sigma_color=float("nan")), ["--sigma-color", "nan"]),
     (dict(aov="/nonexistent/dir"), ["--aov", "/nonexistent/dir"]),
+    (dict(layers="sometimes"), ["--layers", "sometimes"]),
     (dict(no_such_option=1), ["--no-such-option=1"]),
 ]
 

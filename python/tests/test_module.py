@@ -80,6 +80,12 @@ def test_keywords_reach_the_options(cornell):
     plain = render(cornell, method="atrous", no_variance=True)
     assert not np.array_equal(guided.color, plain.color)
     assert np.array_equal(guided.color, render(cornell, method="atrous", no_variance=False).color)
+    # An option with values: layers="on"|"off"|"auto"; True and False are "on" and "off".
+    layered = render(cornell, method="mc", layers="on")
+    plain = render(cornell, method="mc", layers="off")
+    assert not np.array_equal(layered.color, plain.color)
+    assert np.array_equal(render(cornell, method="mc", layers=True).color, layered.color)
+    assert np.array_equal(render(cornell, method="mc", layers=False).color, plain.color)
 
 
 def test_load_scene_dict_equals_the_file(monkeypatch):
