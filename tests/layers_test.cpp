@@ -274,6 +274,10 @@ TEST(Layers, AutoReconstructsForMonteCarloAndAtrousAndABadValueIsAnError) {
         const bool expected = std::string(method) == "mc" || std::string(method) == "atrous";
         EXPECT_EQ(r.figure("layers_sample_bytes").has_value(), expected) << method;
     }
+    render::RenderOptions high;  // a reference's sample count: plain Monte Carlo
+    high.spp = render::RenderOptions::kLayersAutoSpp + 1;
+    high.quiet = true;
+    EXPECT_FALSE(render::render(scene::Scene(parse(kDefocusedEdge)), high).figure("layers_sample_bytes").has_value());
     render::RenderOptions o;
     o.layers = "maybe";
     scene::Scene s(parse(kDefocusedEdge));

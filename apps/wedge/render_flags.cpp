@@ -64,7 +64,7 @@ void addMethodFlags(CLI::App& cmd, render::RenderOptions& r) {
     cmd.add_flag("!--no-variance", r.atrousVarianceGuided,
                  "atrous: plain colour edge-stopping instead of variance-guided (SVGF-style)");
     cmd.add_option("--layers", r.layers,
-                   "auto (default: on for mc and atrous, off for aaf and maaf), on: the layered reconstruction of "
+                   "auto (default: on for mc and atrous up to 64 spp, off for aaf and maaf), on: the layered reconstruction of "
                    "defocus and motion blur across pixels, off: each pixel's own samples (and aaf's and maaf's defocus filter)")
         ->check(CLI::IsMember({"auto", "on", "off"}));
 }

@@ -178,7 +178,7 @@ RenderResult render(const scene::Scene& scene, const RenderOptions& options) {
     LightFieldSamples lightField;
     if (options.layers != "auto" && options.layers != "on" && options.layers != "off")
         throw Error("--layers", "expected auto, on or off, got '" + options.layers + "'");
-    const bool layered = options.layered() && (camera.hasLens() || desc.hasMotion());
+    const bool layered = options.layered(spp) && (camera.hasLens() || desc.hasMotion());
     if (layered) lightField = LightFieldSamples(desc.camera.width, desc.camera.height);
     MethodContext ctx{scene, options, sampler, sampler.view(), spp, layered ? &lightField : nullptr};
 

@@ -45,10 +45,17 @@ struct RenderOptions {
     // The layered reconstruction of defocus and motion blur across pixels (filter/layers.h),
     // where the camera has a lens or the scene moves: "on", "off" (each pixel composes its own
     // samples by surface, and aaf and maaf apply their defocus filter) or "auto", the measured
-    // better of the two per method: on for mc and atrous, off for aaf and maaf (docs/layers.md).
+    // better of the two per method: on for mc and atrous up to kLayersAutoSpp samples per pixel,
+    // off for aaf and maaf (docs/layers.md).
     std::string layers = "auto";
-    /// Whether `method` reconstructs with layers under this setting.
-    bool layered() const { return layers == "on" || (layers == "auto" && (method == "mc" || method == "atrous")); }
+    /// `auto` reconstructs with layers up to this many samples per pixel: where it was measured
+    /// (16-64), and where the samples it keeps (24 bytes each) fit: a 4096-spp reference at
+    /// 512x512 would keep 26 GB and take the stage minutes for what plain Monte Carlo already has.
+    static constexpr int kLayersAutoSpp = 64;
+    /// Whether `method` at `spp` samples per pixel reconstructs with layers under this setting.
+    bool layered(int spp) const {
+        return layers == "on" || (layers == "auto" && (method == "mc" || method == "atrous") && spp <= kLayersAutoSpp);
+    }
 };
 
 struct RenderResult {
