@@ -267,8 +267,10 @@ TEST(Render, MotionBlurIsTheShutterAverage) {
         o.quiet = true;
         render::RenderResult r = renderJson(json, o);
         render::Camera cam(parse(json).camera);
+        // A lambda may not capture structured bindings before C++20's P1091 (clang 14 refuses).
+        const double d = 0.6 * (close - open);
         auto covered = [&](double x) {  // the share of the shutter during which the strip covers x
-            const double x0 = -0.4, w = 0.2, d = 0.6 * (close - open);
+            const double x0 = -0.4, w = 0.2;
             const double s0 = std::max(0.0, (x - x0 - w) / d), s1 = std::min(1.0, (x - x0) / d);
             return std::max(0.0, s1 - s0);
         };

@@ -139,7 +139,11 @@ Image3f atrousFilter(const AtrousInput& in, const AtrousParams& params) {
                     const float hw = kB3[i + 2] * kB3[j + 2];
                     const size_t tapRow = size_t(yy) * w + dx;  // tap of pixel x: tapRow + x
                     // The accumulators alias none of the planes (the compiler cannot prove it).
+#if defined(__clang__)
+#pragma clang loop vectorize(assume_safety)
+#else
 #pragma GCC ivdep
+#endif
                     for (int x = x0; x < x1; ++x) {
                         const size_t p = row + x, q = tapRow + x;
                         const EdgeScales s{invNormal2, ip[p], il[p], ic[p]};
