@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <limits>
 #include <set>
 
 #include "core/error.h"
@@ -137,17 +138,21 @@ std::vector<std::string> JsonNode::keys() const {
     return k;
 }
 
-double JsonNode::number() const {
+float JsonNode::number() const {
     if (!m_value.is_number()) fail(std::string("expected a number, got ") + typeName(m_value));
-    double v = m_value.get<double>();
-    if (!std::isfinite(v)) fail("expected a finite number");
+    const double v = m_value.get<double>();
+    // The OBJ/MTL reader's words for the same check (scene/obj_check.cpp).
+    if (!(std::abs(v) <= double(std::numeric_limits<float>::max())))
+        fail("'" + m_value.dump() + "' is not a finite number within +-3.4e38 (the float it is stored in)");
+    return float(v);
+}
+float JsonNode::positive() const {
+    if (!m_value.is_number() || !(m_value.get<double>() > 0)) fail("expected a positive number");
+    const float v = number();
+    if (!(v > 0)) fail("expected a positive number ('" + m_value.dump() + "' is 0 as the float it is stored in)");
     return v;
 }
-double JsonNode::positive() const {
-    if (!m_value.is_number() || !(m_value.get<double>() > 0)) fail("expected a positive number");
-    return number();
-}
-double JsonNode::nonNegative() const {
+float JsonNode::nonNegative() const {
     if (!m_value.is_number() || !(m_value.get<double>() >= 0)) fail("expected a non-negative number");
     return number();
 }
@@ -168,7 +173,7 @@ std::string JsonNode::string() const {
 Vec3f JsonNode::vec3() const {
     if (!m_value.is_array() || m_value.size() != 3) fail("expected an array of 3 numbers");
     Vec3f v;
-    for (int i = 0; i < 3; ++i) v[i] = float((*this)[size_t(i)].number());
+    for (int i = 0; i < 3; ++i) v[i] = (*this)[size_t(i)].number();
     return v;
 }
 Vec3f JsonNode::color() const {

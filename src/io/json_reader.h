@@ -39,9 +39,12 @@ public:
     JsonNode operator[](int i) const { return (*this)[size_t(i)]; }
     std::vector<std::string> keys() const;
 
-    double number() const;
-    double positive() const;     // > 0
-    double nonNegative() const;  // >= 0
+    /// Numbers as the float a scene stores them in, checked as that float: 1e308 is a finite
+    /// double but an infinite float (a light of that radiance rendered NaN pixels), and 1e-50 is a
+    /// positive double but a zero float.
+    float number() const;
+    float positive() const;     // > 0 as a float
+    float nonNegative() const;  // >= 0
     int integer() const;
     bool boolean() const;
     std::string string() const;

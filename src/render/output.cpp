@@ -36,6 +36,19 @@ void writeOutput(const RenderResult& r, const std::string& path) {
     io::writeExr(path, r.color.width(), r.color.height(), exrChannels(r));
 }
 
+size_t nonFinitePixels(const RenderResult& r) {
+    const FrameBuffers& b = r.buffers;
+    auto sampled = [&](size_t p) {  // the planes that sum samples' light
+        bool ok = isFinite(b.emission[p]) && isFinite(b.direct[p]) && isFinite(b.indirect[p]) && isFinite(b.rest[p]);
+        for (const auto& o : b.other) ok = ok && isFinite(o.direct[p]) && isFinite(o.indirect[p]);
+        return ok;
+    };
+    const bool hasBuffers = b.width == r.color.width() && b.height == r.color.height() && b.emission.size() == r.color.size();
+    size_t count = 0;
+    for (size_t p = 0; p < r.color.size(); ++p) count += !isFinite(r.color[p]) || (hasBuffers && !sampled(p));
+    return count;
+}
+
 nlohmann::json statsJson(const RenderResult& r, const std::string& sceneName) {
     nlohmann::json j;
     j["scene"] = sceneName;
@@ -50,6 +63,7 @@ nlohmann::json statsJson(const RenderResult& r, const std::string& sceneName) {
     double sampling = r.seconds.get("sampling");
     j["rays_per_second"] = sampling > 0 ? double(r.rays) / sampling : 0.0;
     for (auto& [k, v] : r.extra) j[k] = v;
+    j["nonfinite_pixels"] = nonFinitePixels(r);
     return j;
 }
 

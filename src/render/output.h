@@ -17,7 +17,12 @@ const std::vector<std::string>& outputExtensions();
 /// "normal.X", ...); they point into `result`.
 std::vector<io::ExrChannel> exrChannels(const RenderResult& result);
 void writeOutput(const RenderResult& result, const std::string& path);
+/// --stats: timings, counts, the method's figures and `nonfinite_pixels`.
 nlohmann::json statsJson(const RenderResult& result, const std::string& sceneName);
+/// Pixels whose sampled light (emission, direct, indirect, further surfaces, rest) or final
+/// colour is NaN or infinite: every pixel with a non-finite sample, and every pixel a filter made
+/// non-finite. A correct render has none; the count makes one that has them visible.
+size_t nonFinitePixels(const RenderResult& result);
 std::string timingSummary(const RenderResult& result);
 
 }  // namespace wedge::render

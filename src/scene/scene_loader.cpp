@@ -43,7 +43,7 @@ Vec3f readScale(JsonNode node) {
         if (s.x <= 0 || s.y <= 0 || s.z <= 0) node.fail("expected positive scale factors");
         return s;
     }
-    return Vec3f(float(node.positive()));
+    return Vec3f(node.positive());
 }
 
 /// "a, b, c and 2 more": the first few items for a warning.
@@ -120,7 +120,7 @@ private:
         if (length(forward) <= 0) c["look_at"].fail("must differ from camera.position");
         if (length(cross(normalize(forward), cam.up)) < 1e-6f) c["up"].fail("must not be parallel to the view direction");
         JsonNode fov = c["fov_y"];
-        cam.fovY = float(fov.positive());
+        cam.fovY = fov.positive();
         if (cam.fovY >= 180.f) fov.fail("expected an angle in degrees below 180");
         JsonNode res = c["resolution"];
         if (res.size() != 2) res.fail("expected [width, height]");
@@ -131,13 +131,13 @@ private:
             if (v > kMaxImageSide) r.fail("resolution above " + std::to_string(kMaxImageSide) + " is not supported");
             (i == 0 ? cam.width : cam.height) = v;
         }
-        if (auto a = c.optional("aperture_radius")) cam.apertureRadius = float(a->nonNegative());
+        if (auto a = c.optional("aperture_radius")) cam.apertureRadius = a->nonNegative();
         cam.focusDistance = length(forward);
-        if (auto f = c.optional("focus_distance")) cam.focusDistance = float(f->positive());
+        if (auto f = c.optional("focus_distance")) cam.focusDistance = f->positive();
         if (auto s = c.optional("shutter")) {
             if (s->size() != 2) s->fail("expected [open, close]");
-            cam.shutterOpen = float((*s)[0].number());
-            cam.shutterClose = float((*s)[1].number());
+            cam.shutterOpen = (*s)[0].number();
+            cam.shutterClose = (*s)[1].number();
             if (!(cam.shutterClose > cam.shutterOpen)) s->fail("expected close > open");
             if (std::max(std::abs(cam.shutterOpen), std::abs(cam.shutterClose)) > kMaxShutterTime)
                 s->fail("expected times within +-1e6");
@@ -158,7 +158,7 @@ private:
                 mat.texture = t->string();
                 if (mat.texture != "checker") t->fail("unknown texture '" + mat.texture + "' (expected \"checker\")");
             }
-            if (auto ts = m.optional("texture_scale")) mat.textureScale = float(ts->positive());
+            if (auto ts = m.optional("texture_scale")) mat.textureScale = ts->positive();
             m.finish();
             m_materialIndex[name] = uint32_t(m_desc.materials.size());
             m_desc.materials.push_back(mat);
@@ -176,7 +176,7 @@ private:
                 l["type"].fail("unknown light type '" + type + "' (expected \"parallelogram\", \"triangle\" or \"sphere\")");
             if (light.sphere()) {
                 light.corner = l["center"].vec3();
-                light.radius = float(l["radius"].positive());
+                light.radius = l["radius"].positive();
                 light.radiance = l["radiance"].color();
                 checkExtent(l, {light.corner - Vec3f(light.radius), light.corner + Vec3f(light.radius)});
             } else {
@@ -245,7 +245,7 @@ private:
             } else if (type == "sphere") {
                 Sphere s;
                 s.center = o["center"].vec3();
-                s.radius = float(o["radius"].positive());
+                s.radius = o["radius"].positive();
                 s.material = material(o["material"]);
                 s.velocity = mesh.velocity;
                 checkExtent(o, {s.center - Vec3f(s.radius), s.center + Vec3f(s.radius)}, s.velocity);
@@ -281,7 +281,7 @@ private:
             Vec3f axis((*r)[0].number(), (*r)[1].number(), (*r)[2].number());
             if (length(axis) <= 0) r->fail("rotation axis must be non-zero");
             xf.axis = normalize(axis);
-            xf.radians = float((*r)[3].number()) * kDegToRad;
+            xf.radians = (*r)[3].number() * kDegToRad;
         }
         std::vector<AreaLight> promoted;
         loadObj(p.string(), fileNode.where(), overrideMaterial, m_desc.materials, mesh, promoted, m_desc.warnings);
