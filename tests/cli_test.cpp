@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <sys/wait.h>
+#include <nlohmann/json.hpp>
 
 #include "io/image_io.h"
 #include "test_util.h"
@@ -64,6 +66,10 @@ TEST(Cli, GoodSceneRenders) {
               0)
         << err;
     for (const char* f : {"a.png", "a.exr", "a.pfm", "s.json"}) EXPECT_TRUE(fs::exists(dir + "/" + f)) << f;
+    // --stats counts the pixels with a non-finite sample or colour: a correct render has none.
+    const auto stats = nlohmann::json::parse(readFile(dir + "/s.json"));
+    ASSERT_TRUE(stats.contains("nonfinite_pixels")) << stats.dump();
+    EXPECT_EQ(stats["nonfinite_pixels"], 0);
 }
 
 TEST(Cli, TheExrFileIsTheSameOnAnyNumberOfThreads) {
@@ -186,6 +192,23 @@ TEST(Cli, NumberOutOfRangeNamesItsPath) {
                    "bad.json: objects[0].radius: invalid JSON: number overflow");
     expectRejected(scene(kSphere, "\"edge2\": [0, 0, 1]", "\"edge2\": [0, 0, -1e999]"),
                    "bad.json: lights[0].edge2[2]: invalid JSON: number overflow");
+}
+
+TEST(Cli, NumbersAreCheckedAsTheFloatsTheSceneKeeps) {
+    // 1e308 is a finite double and an infinite float: a light of that radiance loaded, and
+    // `--method aaf` rendered NaN pixels (and the PNG writer converted NaN to int).
+    for (const char* method : {"mc", "aaf"})
+        expectRejected(scene(kSphere, "\"radiance\": [5, 5, 5]", "\"radiance\": [1e308, 5, 5]"),
+                       "bad.json: lights[0].radiance[0]: '1e+308' is not a finite number within +-3.4e38", std::string("--method ") + method);
+    expectRejected(scene(kSphere, "\"fov_y\": 40", "\"fov_y\": -3.5e38"), "bad.json: camera.fov_y: expected a positive number");
+    expectRejected(scene(kSphere, "\"up\": [0, 1, 0]", "\"up\": [0, 3.5e38, 0]"),
+                   "bad.json: camera.up[1]: '3.5e+38' is not a finite number within +-3.4e38");
+    // Positive as a double, zero as a float.
+    expectRejected(scene(R"({"type": "sphere", "center": [0, 0, 0], "radius": 1e-50, "material": "white"})"),
+                   "bad.json: objects[0].radius: expected a positive number ('1e-50' is 0 as the float it is stored in)");
+    // The largest float still loads (and is then refused for what it is: a coordinate too far).
+    expectRejected(scene(R"({"type": "sphere", "center": [3.4e38, 0, 0], "radius": 1, "material": "white"})"),
+                   "bad.json: objects[0]: reaches");
 }
 
 TEST(Cli, CoordinatesBeyondWhatEmbreeTracesAreErrors) {
@@ -397,4 +420,56 @@ TEST(Cli, ScenesListsBuiltins) {
     std::string out;
     EXPECT_EQ(runWedge("scenes", &out), 0);
     for (const char* name : {"cornell", "grids", "conference", "sponza", "bunny"}) EXPECT_NE(out.find(name), std::string::npos) << name;
+}
+
+/// Runs `script` with /bin/sh (std::system's shell), $WEDGE standing for the binary; returns the
+/// exit status.
+int runShell(const std::string& script) {
+    const int status = std::system(("WEDGE='" + std::string(WEDGE_BIN) + "'; " + script).c_str());
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+TEST(Cli, AnInterruptedRenderExitsNonZeroAndWritesNothing) {
+    // A render far longer than the second before the signal: exit 128 + the signal, a message,
+    // and neither the outputs nor their temporaries on disk.
+    for (const char* sig : {"INT", "TERM"}) {
+        std::string dir = tempDir();
+        writeFile(dir + "/good.json", scene(kSphere));
+        const int rc = runShell("timeout 120 $WEDGE render " + dir + "/good.json --spp 100000 --resolution 256x256 -o " + dir +
+                                "/a.exr -o " + dir + "/a.png --stats " + dir + "/s.json --quiet 2>" + dir +
+                                "/err.txt & pid=$!; sleep 1; kill -" + sig + " $pid; wait $pid");
+        EXPECT_EQ(rc, std::string(sig) == "INT" ? 130 : 143) << sig;
+        const std::string err = readFile(dir + "/err.txt");
+        EXPECT_NE(err.find(std::string(sig) == "INT" ? "wedge: interrupted by SIGINT" : "wedge: terminated by SIGTERM"),
+                  std::string::npos)
+            << err;
+        for (auto& e : fs::directory_iterator(dir)) {
+            const std::string name = e.path().filename().string();
+            EXPECT_TRUE(name == "good.json" || name == "err.txt") << "left behind: " << name;
+        }
+    }
+}
+
+TEST(Cli, AFailedWriteIsAnErrorAndKeepsThePreviousOutput) {
+    // Outputs larger than `ulimit -f` allows (a full disk, as the writer sees it: EFBIG): exit
+    // 2 naming the file, the previous outputs byte for byte as they were, no temporaries.
+    std::string dir = tempDir(), err;
+    writeFile(dir + "/good.json", scene(kSphere));
+    const std::string outs = " -o " + dir + "/a.exr -o " + dir + "/a.png -o " + dir + "/a.pfm";
+    ASSERT_EQ(runWedge("render " + dir + "/good.json --quiet" + outs, nullptr, &err), 0) << err;
+    std::vector<std::string> before;
+    for (const char* f : {"a.exr", "a.png", "a.pfm"}) before.push_back(readFile(dir + "/" + f));
+    for (const char* f : {"a.exr", "a.png", "a.pfm"}) {
+        // 2 blocks of 512 bytes: less than any of the three at 128x128 (the PNG is 14 KB).
+        const int rc = runShell("ulimit -f 2; $WEDGE render " + dir + "/good.json --quiet --resolution 128x128 -o " + dir +
+                                "/" + f + " 2>" + dir + "/err.txt");
+        EXPECT_EQ(rc, 2) << f;
+        const std::string e = readFile(dir + "/err.txt");
+        EXPECT_NE(e.find(dir + "/" + f + ": "), std::string::npos) << e;
+    }
+    for (int k = 0; k < 3; ++k) EXPECT_TRUE(readFile(dir + "/" + std::string(k == 0 ? "a.exr" : k == 1 ? "a.png" : "a.pfm")) == before[k]) << k;
+    for (auto& e : fs::directory_iterator(dir)) EXPECT_EQ(e.path().filename().string().find(".tmp"), std::string::npos) << e.path();
+    // A path no one can write (not even root): a clear error, no file.
+    EXPECT_EQ(runWedge("render " + dir + "/good.json --quiet -o /proc/wedge-test.exr", nullptr, &err), 2);
+    EXPECT_NE(err.find("/proc/wedge-test.exr: "), std::string::npos) << err;
 }

@@ -4,15 +4,20 @@
 #include <zlib.h>
 
 #include <atomic>
+#include <climits>
+#include <cmath>
 #include <filesystem>
+#include <limits>
 
 #include "core/cancel.h"
 #include "core/error.h"
 #include "core/image.h"
 #include "core/parallel.h"
 #include "core/progress.h"
+#include "core/memory_limit.h"
 #include "core/sampler.h"
 #include "io/image_io.h"
+#include "render/output.h"
 #include "test_util.h"
 
 using namespace wedge;
@@ -168,7 +173,8 @@ TEST(Image, FillsAndCopiesEveryPixelOverReusedMemory) {
         assigned = copy;
         EXPECT_EQ(assigned.width(), 700);
         EXPECT_EQ(assigned[12345].n, 3u);
-        assigned = assigned;  // self-assignment keeps the pixels
+        const Image<Px>& self = assigned;  // through a reference: clang warns on `x = x`
+        assigned = self;                    // self-assignment keeps the pixels
         EXPECT_EQ(assigned[12345].n, 3u);
     }
 }
@@ -245,6 +251,86 @@ TEST(ImageIo, HeadersAreCheckedBeforeAllocating) {
     EXPECT_NE(readError(dir + "/cut.png").find("corrupt PNG file ("), std::string::npos) << readError(dir + "/cut.png");
 }
 
+TEST(ImageIo, ExrHeadersAreCheckedBeforeAllocating) {
+    // readExr sized every channel from the header before reading a pixel: a 400 KB file whose
+    // header gives 50000 x 50000 grew `wedge compare` to 24 GB until the kernel killed it.
+    std::string dir = test::tempDir();
+    test::writeFile(dir + "/bomb.exr", test::exrHeader(0, 0, 49999, 49999, 3, 50000));
+    const std::string bomb = readError(dir + "/bomb.exr");
+    EXPECT_NE(bomb.find(dir + "/bomb.exr: "), std::string::npos) << bomb;
+    EXPECT_NE(bomb.find("16384"), std::string::npos) << "names the bound: " << bomb;
+    // A window over all of int's range is 2^32 pixels wide: its size must not overflow int.
+    test::writeFile(dir + "/wide.exr", test::exrHeader(INT_MIN, 0, INT_MAX, 0, 1, 1));
+    EXPECT_NE(readError(dir + "/wide.exr").find("not a readable EXR file"), std::string::npos) << readError(dir + "/wide.exr");
+    test::writeFile(dir + "/all.exr", test::exrHeader(INT_MIN, INT_MIN, INT_MAX, INT_MAX, 1, 0));
+    EXPECT_NE(readError(dir + "/all.exr").find(dir + "/all.exr: "), std::string::npos) << readError(dir + "/all.exr");
+    // Within the side bound, the channels' floats against the memory limit: 3 x 4096 x 4096 x 4 bytes.
+    test::writeFile(dir + "/deep.exr", test::exrHeader(0, 0, 4095, 4095, 3, 4096));
+    setMemoryLimit(uint64_t(64) << 20);
+    const std::string deep = readError(dir + "/deep.exr");
+    setMemoryLimit(0);
+    EXPECT_NE(deep.find("the EXR's 3 channels of 4096x4096 floats needs 192.0 MiB, more than the memory limit of 64.0 MiB (--max-memory)"),
+              std::string::npos)
+        << deep;
+    // The same file within the limit is read, and refused for what it is: lines that are not there.
+    const std::string missing = readError(dir + "/deep.exr");
+    EXPECT_NE(missing.find("not a readable EXR file"), std::string::npos) << missing;
+}
+
+TEST(ImageIo, TheMemoryLimitCoversEveryReader) {
+    std::string dir = test::tempDir();
+    Image3f img(64, 64, Vec3f(0.25f));
+    for (const char* f : {"/a.png", "/a.pfm", "/a.exr"}) io::writeColor(dir + f, img);
+    test::writeJpeg(dir + "/a.jpg", 64, 64, 1, std::vector<unsigned char>(64 * 64, 90), 90);
+    setMemoryLimit(1000);  // bytes: less than any 64 x 64 image
+    std::vector<std::string> errors;
+    for (const char* f : {"/a.png", "/a.pfm", "/a.exr"}) errors.push_back(readError(dir + f));
+    errors.push_back(test::errorOf([&] { io::readJpeg(dir + "/a.jpg"); }));
+    setMemoryLimit(0);
+    for (const std::string& e : errors) EXPECT_NE(e.find("more than the memory limit of 1000 bytes (--max-memory)"), std::string::npos) << e;
+    EXPECT_EQ(readError(dir + "/a.png"), "");
+    EXPECT_GT(memoryLimit(), uint64_t(1) << 20) << "the default: the machine's memory";
+    EXPECT_EQ(parseMemorySize("512M", "--max-memory"), uint64_t(512) << 20);
+    EXPECT_EQ(parseMemorySize("1.5GiB", "--max-memory"), uint64_t(3) << 29);
+    EXPECT_EQ(parseMemorySize("4096", "--max-memory"), 4096u);
+    for (const char* bad : {"", "-1G", "nan", "8Q", "1e30T", "0"})
+        EXPECT_NE(test::errorOf([&] { parseMemorySize(bad, "--max-memory"); }).find("--max-memory: '"), std::string::npos) << bad;
+}
+
+TEST(ImageIo, PngMapsNonFiniteValuesToFixedBytes) {
+    // NaN went through int() (undefined behaviour; UBSan stopped on it): now black, +inf white.
+    const float inf = std::numeric_limits<float>::infinity(), nan = std::numeric_limits<float>::quiet_NaN();
+    Image3f img(4, 1);
+    img(0, 0) = Vec3f(nan, nan, nan);
+    img(1, 0) = Vec3f(inf, inf, inf);
+    img(2, 0) = Vec3f(-inf, -inf, -inf);
+    img(3, 0) = Vec3f(0.5f, 2.f, -1.f);
+    std::string dir = test::tempDir();
+    io::writePng(dir + "/n.png", img);
+    const Image3f back = io::readPng(dir + "/n.png");
+    EXPECT_EQ(back(0, 0), Vec3f(0.f));
+    EXPECT_EQ(back(1, 0), Vec3f(1.f));
+    EXPECT_EQ(back(2, 0), Vec3f(0.f));
+    EXPECT_NEAR(back(3, 0).x, 0.5f, 0.01f);
+    EXPECT_EQ(back(3, 0).y, 1.f);
+    EXPECT_EQ(back(3, 0).z, 0.f);
+}
+
+TEST(RenderStats, NonFinitePixelsCountsSamplesAndColour) {
+    render::RenderResult r;
+    r.color = Image3f(4, 2, Vec3f(0.5f));
+    r.buffers = FrameBuffers(4, 2);
+    EXPECT_EQ(render::nonFinitePixels(r), 0u);
+    r.color(1, 0).y = std::numeric_limits<float>::quiet_NaN();
+    r.buffers.direct(2, 1).x = std::numeric_limits<float>::infinity();
+    r.buffers.other[1].indirect(3, 1).z = -std::numeric_limits<float>::infinity();
+    r.buffers.rest(1, 0).x = std::numeric_limits<float>::quiet_NaN();  // the same pixel as the colour's
+    EXPECT_EQ(render::nonFinitePixels(r), 3u);
+    // The planes that are infinite by design (no occluder: an infinite slope) do not count.
+    r.buffers.sMax(0, 0) = std::numeric_limits<float>::infinity();
+    EXPECT_EQ(render::nonFinitePixels(r), 3u);
+    EXPECT_EQ(render::statsJson(r, "s")["nonfinite_pixels"], 3);
+}
 
 TEST(ImageIo, JpegTexturesDecodeFromSrgbToLinear) {
     // Four flat 16 x 16 quadrants (whole blocks, so the lossy code keeps them flat) and a

@@ -418,3 +418,22 @@ TEST(CompareCommand, BadInputExitsWithTwo) {
     EXPECT_EQ(test::runWedge("compare " + dir + "/a.pfm " + dir + "/missing.pfm", nullptr, &err), 2);
     EXPECT_EQ(test::runWedge("compare " + dir + "/a.pfm " + dir + "/a.pfm --heatmap " + dir + "/h.jpg", nullptr, &err), 2);
 }
+
+TEST(CompareCommand, AnExrBombIsRefusedBeforeAllocating) {
+    // 50000 x 50000 in a 400 KB file: `wedge compare` grew to 24 GB before; now exit 2 at once.
+    std::string dir = test::tempDir(), err;
+    test::writeFile(dir + "/bomb.exr", test::exrHeader(0, 0, 49999, 49999, 3, 50000));
+    io::writePfm(dir + "/r.pfm", constant(4, 4, 1.f));
+    EXPECT_EQ(test::runWedge("compare " + dir + "/bomb.exr " + dir + "/r.pfm", nullptr, &err), 2);
+    EXPECT_NE(err.find(dir + "/bomb.exr: "), std::string::npos) << err;
+    EXPECT_NE(err.find("16384"), std::string::npos) << err;
+    // --max-memory lowers the limit every reader checks.
+    io::writePfm(dir + "/a.pfm", constant(64, 64, 1.f));
+    EXPECT_EQ(test::runWedge("compare " + dir + "/a.pfm " + dir + "/a.pfm --max-memory 10K", nullptr, &err), 2);
+    EXPECT_NE(err.find("a.pfm: the PFM's 64x64 pixels needs 96.0 KiB, more than the memory limit of 10.0 KiB (--max-memory)"),
+              std::string::npos)
+        << err;
+    EXPECT_EQ(test::runWedge("compare " + dir + "/a.pfm " + dir + "/a.pfm --max-memory 1G", nullptr, &err), 0) << err;
+    EXPECT_EQ(test::runWedge("compare " + dir + "/a.pfm " + dir + "/a.pfm --max-memory lots", nullptr, &err), 2);
+    EXPECT_NE(err.find("--max-memory: 'lots' is not a memory size"), std::string::npos) << err;
+}

@@ -90,4 +90,51 @@ void writeJpeg(const std::string& path, int w, int h, int components, const std:
     std::fclose(fp);
 }
 
+std::string exrHeader(int x0, int y0, int x1, int y1, int channels, size_t offsets) {
+    std::string b;
+    auto i32 = [&](uint32_t v) {
+        for (int k = 0; k < 4; ++k) b += char(v >> (8 * k));
+    };
+    auto attribute = [&](const char* name, const char* type, uint32_t size) {
+        b += name;
+        b += '\0';
+        b += type;
+        b += '\0';
+        i32(size);
+    };
+    auto box = [&](int a, int c, int d, int e) {
+        for (int v : {a, c, d, e}) i32(uint32_t(v));
+    };
+    b += "\x76\x2f\x31\x01";  // magic
+    i32(2);                       // version 2, scan lines
+    attribute("channels", "chlist", uint32_t(channels * (4 + 16) + 1));
+    for (int c = 0; c < channels; ++c) {
+        b += {'c', char('0' + c / 10 % 10), char('0' + c % 10), '\0'};  // c00, c01...: sorted, as the list must be
+        i32(2);                    // FLOAT
+        b += std::string(4, '\0');  // pLinear, reserved
+        i32(1);
+        i32(1);                    // x and y sampling
+    }
+    b += '\0';
+    attribute("compression", "compression", 1);
+    b += '\0';  // none
+    attribute("dataWindow", "box2i", 16);
+    box(x0, y0, x1, y1);
+    attribute("displayWindow", "box2i", 16);
+    box(0, 0, 0, 0);
+    attribute("lineOrder", "lineOrder", 1);
+    b += '\0';
+    attribute("pixelAspectRatio", "float", 4);
+    i32(0x3f800000);  // 1.0f
+    attribute("screenWindowCenter", "v2f", 8);
+    i32(0);
+    i32(0);
+    attribute("screenWindowWidth", "float", 4);
+    i32(0x3f800000);
+    b += '\0';  // end of the header
+    for (size_t k = 0; k < offsets; ++k) b += std::string("\xff\xff\xff\x00\x00\x00\x00\x00", 8);
+    return b;
+}
+
+
 }  // namespace wedge::test

@@ -31,6 +31,11 @@ void writeJpeg(const std::string& path, int w, int h, int components, const std:
 /// Runs the wedge binary with `args` (a shell-quoted string); returns the exit code and captures
 /// stderr into `err` and stdout into `out` when given.
 int runWedge(const std::string& args, std::string* out = nullptr, std::string* err = nullptr);
+/// The bytes of a scan-line EXR header over the data window (x0, y0)-(x1, y1) with `channels`
+/// FLOAT channels, no compression, then `offsets` line offsets that point past the end of the
+/// file (the layout of OpenEXR's "OpenEXR File Layout"): a header that asks for what it likes
+/// with almost no file behind it.
+std::string exrHeader(int x0, int y0, int x1, int y1, int channels, size_t offsets);
 /// The repository's source directory.
 std::string sourceDir();
 

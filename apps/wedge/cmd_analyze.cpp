@@ -22,6 +22,7 @@
 #include "core/error.h"
 #include "filter/maaf_components.h"
 #include "io/image_io.h"
+#include "io/output_file.h"
 
 namespace wedge::app {
 
@@ -110,7 +111,7 @@ void runSpectrum(SpectrumArgs a) {
             csv << line;
         }
         std::string path = slopesCsvPath(a.output);
-        analysis::writeTextFile(path, csv.str());
+        io::writeTextFile(path, csv.str());
         std::printf("wrote %s\n", path.c_str());
     }
 }
@@ -267,7 +268,7 @@ void runPenumbra(PenumbraArgs a) {
             for (const auto& r : rs) csv << "," << r.mean[t];
             csv << "\n";
         }
-        analysis::writeTextFile(a.csv, csv.str());
+        io::writeTextFile(a.csv, csv.str());
         std::printf("wrote %s\n", a.csv.c_str());
     }
     if (!a.output.empty()) {

@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "apps/wedge/commands.h"
+#include "apps/wedge/common.h"
 #include "core/error.h"
 #include "io/image_io.h"
 #include "metrics/metrics.h"
@@ -128,6 +129,7 @@ void runCompare(const CompareArgs& a) {
 void registerCompare(CLI::App& app) {
     auto args = std::make_shared<CompareArgs>();
     CLI::App* cmd = app.add_subcommand("compare", "Error metrics of an image against a reference");
+    addMaxMemory(cmd);
     cmd->add_option("test", args->test, "Image to measure (.exr, .png, .pfm)")->required();
     cmd->add_option("reference", args->reference, "Reference image (.exr, .png, .pfm)")->required();
     cmd->add_flag("--json", args->json, "Print the metrics as JSON");

@@ -70,6 +70,7 @@ void registerExperiment(CLI::App& app) {
     auto args = std::make_shared<ExperimentArgs>();
     CLI::App* cmd = app.add_subcommand(
         "experiment", "Render a scene with several methods against a reference; equal-time and equal-quality report");
+    addMaxMemory(cmd);
     cmd->add_option("scene", args->options.sceneName, "Scene file (JSON) or built-in name (see 'wedge scenes')")
         ->required();
     cmd->add_option("--methods", args->options.methods, "Comma-separated methods (default: all; unavailable ones are skipped)")

@@ -7,6 +7,7 @@
 
 #include "apps/wedge/commands.h"
 #include "apps/wedge/common.h"
+#include "io/output_file.h"
 #include "core/error.h"
 #include "core/parallel.h"
 #include "io/image_io.h"
@@ -53,19 +54,6 @@ struct RasterArgs {
     bool quiet = false;
 };
 
-void writeText(const std::string& path, const std::string& text) {
-    std::string tmp = path + ".tmp";
-    {
-        std::ofstream out(tmp);
-        if (!out) throw Error(path, "cannot open for writing");
-        out << text;
-        if (!out) throw Error(path, "write failed");
-    }
-    std::error_code ec;
-    std::filesystem::rename(tmp, path, ec);
-    if (ec) throw Error(path, "cannot write");
-}
-
 raster::RasterOptions options(const RasterArgs& a, const scene::SceneDesc& desc) {
     raster::RasterOptions opt;
     opt.shading = raster::parseShadingMode(a.shading, "--shading");
@@ -98,7 +86,7 @@ void runSweep(const RasterArgs& a) {
     raster::SweepResult sweep = raster::sweepCache(desc, options(a, desc), a.sweep);
 
     fs::path dir(a.outDir);
-    writeText((dir / "sweep.csv").string(), raster::sweepCsv(sweep));
+    io::writeTextFile((dir / "sweep.csv").string(), raster::sweepCsv(sweep));
     writeJsonFile((dir / "sweep.json").string(), raster::sweepJson(sweep, a.scene));
     io::writePng((dir / "sweep.png").string(), raster::sweepPlot(sweep, a.scene));
     io::writePng((dir / "ds.png").string(), sweep.dsImage);
@@ -157,6 +145,7 @@ void registerRaster(CLI::App& app) {
     auto args = std::make_shared<RasterArgs>();
     CLI::App* cmd = app.add_subcommand(
         "raster", "Stochastic rasterizer with decoupled (DS) and adaptive anisotropic (AAS) shading; shading-cost stats");
+    addMaxMemory(cmd);
     cmd->add_option("scene", args->scene, "Scene file (JSON) or built-in name (see 'wedge scenes')")->required();
     cmd->add_option("--shading", args->shading, "ds (pixel grid), aas (adaptive anisotropic grid) or reference (every sample)")
         ->check(CLI::IsMember({"ds", "aas", "reference"}))

@@ -34,6 +34,8 @@ void runRender(const RenderArgs& a) {
     a.flags.applyTo(desc);
     scene::Scene scene(std::move(desc));
     render::RenderResult result = render::render(scene, opt);
+    if (const size_t bad = render::nonFinitePixels(result); bad > 0)
+        std::fprintf(stderr, "wedge: warning: %zu pixels have non-finite (NaN or infinite) samples or colour\n", bad);
 
     for (const auto& o : a.outputs) render::writeOutput(result, o);
     if (!a.stats.empty()) writeJsonFile(a.stats, render::statsJson(result, a.scene));
@@ -45,6 +47,7 @@ void runRender(const RenderArgs& a) {
 void registerRender(CLI::App& app) {
     auto args = std::make_shared<RenderArgs>();
     CLI::App* cmd = app.add_subcommand("render", "Render a scene file or built-in scene");
+    addMaxMemory(cmd);
     cmd->add_option("scene", args->scene, "Scene file (JSON) or built-in name (see 'wedge scenes')")->required();
     cmd->add_option("-o,--output", args->outputs, "Output image (.exr with all buffers, .png, .pfm); repeatable");
     cmd->add_option("--stats", args->stats, "Write timings and counts as JSON");

@@ -12,8 +12,16 @@
 
 #include "core/error.h"
 #include "core/image.h"
+#include "core/memory_limit.h"
+#include "io/output_file.h"
 
 namespace wedge::app {
+
+void addMaxMemory(CLI::App* cmd) {
+    cmd->add_option_function<std::string>(
+        "--max-memory", [](const std::string& size) { setMemoryLimit(parseMemorySize(size, "--max-memory")); },
+        "Refuse inputs that would need more memory than this (e.g. 8G, 512M; default: the machine's memory)");
+}
 
 void printWarnings(const scene::SceneDesc& desc) {
     for (const auto& w : desc.warnings) std::fprintf(stderr, "wedge: warning: %s\n", w.c_str());
@@ -71,20 +79,6 @@ CLI::Validator numberIn(double lo, double hi) {
                        [lo, hi](double v) { return v >= lo && v <= hi; });
 }
 
-void writeJsonFile(const std::string& path, const nlohmann::json& j) {
-    std::string tmp = path + ".tmp" + std::to_string(getpid());
-    {
-        std::ofstream out(tmp);
-        if (!out) throw Error(path, "cannot open for writing");
-        out << j.dump(2) << "\n";
-        if (!out) throw Error(path, "write failed");
-    }
-    std::error_code ec;
-    std::filesystem::rename(tmp, path, ec);
-    if (ec) {
-        std::filesystem::remove(tmp, ec);
-        throw Error(path, "cannot write");
-    }
-}
+void writeJsonFile(const std::string& path, const nlohmann::json& j) { io::writeTextFile(path, j.dump(2) + "\n"); }
 
 }  // namespace wedge::app

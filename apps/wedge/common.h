@@ -20,6 +20,9 @@ void printWarnings(const scene::SceneDesc& desc);
 CLI::Validator positiveNumber();
 CLI::Validator nonNegativeNumber();
 CLI::Validator numberIn(double lo, double hi);
+/// --max-memory SIZE on `cmd`: the limit that sizes from files and flags are checked against
+/// before anything is allocated (core/memory_limit.h); the machine's memory by default.
+void addMaxMemory(CLI::App* cmd);
 /// Writes JSON through a temporary file and a rename.
 void writeJsonFile(const std::string& path, const nlohmann::json& j);
 

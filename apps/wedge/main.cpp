@@ -4,8 +4,10 @@
 
 #include "apps/wedge/commands.h"
 #include "core/error.h"
+#include "io/output_file.h"
 
 int main(int argc, char** argv) {
+    wedge::io::installSignalHandlers();
     CLI::App app{"wedge: sparse sampling and Fourier-derived reconstruction filters for distribution effects"};
     app.require_subcommand(1);
     app.set_help_all_flag("--help-all", "Show help for every subcommand");

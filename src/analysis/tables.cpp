@@ -15,6 +15,7 @@
 #include "core/error.h"
 #include "filter/maaf_components.h"
 #include "io/image_io.h"
+#include "io/output_file.h"
 
 namespace wedge::analysis {
 
@@ -97,26 +98,6 @@ FourierFilter table2Filter(int column, FilterShape shape, const DoubleWedge& w, 
 }
 
 }  // namespace
-
-void writeTextFile(const std::string& path, const std::string& text) {
-    std::string tmp = path + ".tmp" + std::to_string(getpid());
-    {
-        std::ofstream out(tmp);
-        if (!out) throw Error(path, "cannot open for writing");
-        out << text;
-        if (!out) {
-            std::error_code ec;
-            std::filesystem::remove(tmp, ec);
-            throw Error(path, "write failed");
-        }
-    }
-    std::error_code ec;
-    std::filesystem::rename(tmp, path, ec);
-    if (ec) {
-        std::filesystem::remove(tmp, ec);
-        throw Error(path, "cannot write: " + ec.message());
-    }
-}
 
 std::vector<DoubleWedge> randomWedges(int count, uint64_t seed, double sLimit) {
     std::vector<DoubleWedge> out;
@@ -211,7 +192,7 @@ TableReport writeTables(const std::string& dir, const TableOptions& opt) {
                           n.mean, n.sem, p.mean, c.mean, dev);
             sum << line;
         }
-        writeTextFile(path("table1.csv"), csv.str());
+        io::writeTextFile(path("table1.csv"), csv.str());
         report.files.push_back(path("table1.csv"));
 
         LinePlot lp;
@@ -293,7 +274,7 @@ TableReport writeTables(const std::string& dir, const TableOptions& opt) {
                     for (int s = 0; s < ns; ++s) csv << "," << fmt(metric == 0 ? cov[at(row, col, s)] : acc[at(row, col, s)]);
                     csv << "\n";
                 }
-        writeTextFile(path("table2.csv"), csv.str());
+        io::writeTextFile(path("table2.csv"), csv.str());
         report.files.push_back(path("table2.csv"));
 
         sum << "\nTable 2 (Gaussians): paper | ours (plane) | ours (wedgebox) | ours (wedgebox, mu_p = 1)\n";
@@ -401,7 +382,7 @@ TableReport writeTables(const std::string& dir, const TableOptions& opt) {
             csv << "," << fmt(paperBox(ks[k]), 3) << "," << fmt(paperGauss(ks[k], 0), 3) << ","
                 << fmt(paperGauss(ks[k], 1), 3) << "\n";
         }
-        writeTextFile(path("fig6.csv"), csv.str());
+        io::writeTextFile(path("fig6.csv"), csv.str());
         report.files.push_back(path("fig6.csv"));
 
         LinePlot lp;

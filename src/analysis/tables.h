@@ -64,6 +64,6 @@ struct TableReport {
 TableReport writeTables(const std::string& dir, const TableOptions& options);
 
 /// Writes text through a temporary file and a rename (no half-written outputs).
-void writeTextFile(const std::string& path, const std::string& text);
+
 
 }  // namespace wedge::analysis

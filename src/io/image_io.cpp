@@ -5,6 +5,7 @@
 #include <OpenEXR/ImfHeader.h>
 #include <OpenEXR/ImfInputFile.h>
 #include <OpenEXR/ImfOutputFile.h>
+#include <OpenEXR/ImfStdIO.h>
 #include <OpenEXR/ImfThreading.h>
 #include <png.h>
 #include <cstdio>  // before jpeglib.h, which needs FILE and size_t declared
@@ -23,7 +24,9 @@
 #include <unistd.h>
 
 #include "core/error.h"
+#include "core/memory_limit.h"
 #include "core/parallel.h"
+#include "io/output_file.h"
 
 namespace fs = std::filesystem;
 
@@ -34,28 +37,19 @@ namespace {
 /// The most pixels a read image may have: what wedge renders at most.
 constexpr uint64_t kMaxImagePixels = uint64_t(kMaxImageSide) * kMaxImageSide;
 
-/// Why a header's size is more than wedge reads, or "" if it is not.
+/// Why a header's size is more than wedge reads, or "" if it is not. (Each side first: an EXR's
+/// window can be 2^32 pixels on a side, whose product wraps to 0 in 64 bits.)
 std::string oversize(const char* format, uint64_t w, uint64_t h) {
-    if (w * h <= kMaxImagePixels) return "";
+    if (w <= kMaxImagePixels && h <= kMaxImagePixels && w * h <= kMaxImagePixels) return "";
     return std::string("the ") + format + "'s header gives " + std::to_string(w) + "x" + std::to_string(h) +
            " pixels, more than wedge reads (" + std::to_string(kMaxImageSide) + "x" + std::to_string(kMaxImageSide) + ")";
 }
 
-/// Writes through `write(tmpPath)` and renames onto `path`; removes the temporary on failure.
-template <class Fn>
-void atomicWrite(const std::string& path, Fn&& write) {
-    static std::atomic<int> counter{0};
-    std::string tmp = path + ".tmp" + std::to_string(getpid()) + "-" + std::to_string(counter++);
-    try {
-        write(tmp);
-        std::error_code ec;
-        fs::rename(tmp, path, ec);
-        if (ec) throw Error(path, "cannot write: " + ec.message());
-    } catch (...) {
-        std::error_code ec;
-        fs::remove(tmp, ec);
-        throw;
-    }
+/// Why decoding a w x h image (its rows as the file stores them, `fileBytes` a pixel, then an
+/// Image3f) would exceed the memory limit (core/memory_limit.h), or "" if it would not.
+std::string overMemory(const char* format, uint64_t w, uint64_t h, uint64_t fileBytes) {
+    return overMemoryLimit(std::string("the ") + format + "'s " + std::to_string(w) + "x" + std::to_string(h) + " pixels",
+                           w * h * (fileBytes + sizeof(Vec3f)));
 }
 
 }  // namespace
@@ -105,6 +99,10 @@ constexpr int kZipLevel = 1;
 
 void writeExr(const std::string& path, int width, int height, const std::vector<ExrChannel>& channels) {
     atomicWrite(path, [&](const std::string& tmp) {
+        // Through a stream of wedge's own: OpenEXR writes the line offsets as its OutputFile
+        // closes, and keeps a failure there (a full disk) to itself; the stream's state shows it.
+        std::ofstream os(tmp, std::ios::binary);
+        if (!os) throw Error(path, std::string("cannot open for writing: ") + std::strerror(errno));
         try {
             Imf::Header header(width, height);
             header.compression() = Imf::ZIP_COMPRESSION;
@@ -115,7 +113,8 @@ void writeExr(const std::string& path, int width, int height, const std::vector<
                 fb.insert(c.name, Imf::Slice(Imf::FLOAT, (char*)c.data, sizeof(float) * c.stride,
                                              sizeof(float) * c.stride * size_t(width)));
             }
-            Imf::OutputFile file(tmp.c_str(), header, exrThreads());
+            Imf::StdOFStream stream(os, path.c_str());  // the name OpenEXR's messages give
+            Imf::OutputFile file(stream, header, exrThreads());
             file.setFrameBuffer(fb);
             file.writePixels(height);
         } catch (const Error&) {
@@ -123,27 +122,50 @@ void writeExr(const std::string& path, int width, int height, const std::vector<
         } catch (const std::exception& e) {
             throw Error(path, std::string("cannot write EXR: ") + e.what());
         }
+        os.close();
+        if (!os) throw Error(path, std::string("cannot write EXR: ") + std::strerror(errno));
     });
 }
 
 ExrImage readExr(const std::string& path) {
     if (!fs::is_regular_file(path)) throw Error(path, "no such file");
+    // OpenEXR allocates from the header as it opens a file (an offset per line block: 1 GB for a
+    // window 2^31 lines high) unless told the largest image and tile to accept; the library's own
+    // guard against damaged files, set to what wedge renders at most.
+    static std::once_flag limits;
+    std::call_once(limits, [] {
+        Imf::Header::setMaxImageSize(kMaxImageSide, kMaxImageSide);
+        Imf::Header::setMaxTileSize(kMaxImageSide, kMaxImageSide);
+    });
     try {
         Imf::InputFile file(path.c_str(), exrThreads());
-        Imath::Box2i dw = file.header().dataWindow();
+        const Imath::Box2i dw = file.header().dataWindow();
+        // In 64 bits: a window from INT_MIN to INT_MAX is 2^32 pixels wide.
+        const int64_t w = int64_t(dw.max.x) - dw.min.x + 1, h = int64_t(dw.max.y) - dw.min.y + 1;
+        if (w <= 0 || h <= 0) throw Error(path, "the EXR's data window is empty");
+        if (const std::string why = oversize("EXR", uint64_t(w), uint64_t(h)); !why.empty()) throw Error(path, why);
+        const Imf::ChannelList& list = file.header().channels();
+        uint64_t count = 0;
+        for (auto it = list.begin(); it != list.end(); ++it) ++count;
+        // Every channel is read as w x h floats, allocated before any pixel is read.
+        checkMemory(path, "the EXR's " + std::to_string(count) + " channels of " + std::to_string(w) + "x" +
+                              std::to_string(h) + " floats",
+                    count * uint64_t(w) * uint64_t(h) * sizeof(float));
         ExrImage img;
-        img.width = dw.max.x - dw.min.x + 1;
-        img.height = dw.max.y - dw.min.y + 1;
+        img.width = int(w);
+        img.height = int(h);
         Imf::FrameBuffer fb;
-        for (auto it = file.header().channels().begin(); it != file.header().channels().end(); ++it) {
+        for (auto it = list.begin(); it != list.end(); ++it) {
             auto& v = img.channels[it.name()];
-            v.assign(size_t(img.width) * img.height, 0.f);
-            char* base = (char*)(v.data() - dw.min.x - size_t(dw.min.y) * img.width);
-            fb.insert(it.name(), Imf::Slice(Imf::FLOAT, base, sizeof(float), sizeof(float) * size_t(img.width)));
+            v.assign(size_t(w) * size_t(h), 0.f);
+            // Slice::Make places the window's origin without pointer arithmetic outside the buffer.
+            fb.insert(it.name(), Imf::Slice::Make(Imf::FLOAT, v.data(), dw, sizeof(float), sizeof(float) * size_t(w)));
         }
         file.setFrameBuffer(fb);
         file.readPixels(dw.min.y, dw.max.y);
         return img;
+    } catch (const Error&) {
+        throw;
     } catch (const std::exception& e) {
         throw Error(path, std::string("not a readable EXR file: ") + e.what());
     }
@@ -153,16 +175,32 @@ ExrImage readExr(const std::string& path) {
 
 namespace {
 
+/// libpng prints its errors to stderr by default ("libpng error: Read Error" before wedge's own
+/// message); this handler keeps the text (and errno, for a write) for wedge's message instead.
+struct PngFailure {
+    std::string message;
+    int error = 0;
+};
+void onPngError(png_structp p, png_const_charp message) {
+    auto* f = static_cast<PngFailure*>(png_get_error_ptr(p));
+    f->error = errno;
+    f->message = message;
+    png_longjmp(p, 1);
+}
+void onPngWarning(png_structp, png_const_charp) {}
+
 void writePngRgb8(const std::string& path, int width, int height, const std::vector<unsigned char>& rgb) {
     atomicWrite(path, [&](const std::string& tmp) {
         FILE* fp = std::fopen(tmp.c_str(), "wb");
         if (!fp) throw Error(path, std::string("cannot open for writing: ") + std::strerror(errno));
-        png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
+        PngFailure failure;
+        png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, &failure, onPngError, onPngWarning);
         png_infop info = png_create_info_struct(png);
         if (setjmp(png_jmpbuf(png))) {
             png_destroy_write_struct(&png, &info);
             std::fclose(fp);
-            throw Error(path, "libpng failed to write the image");
+            throw Error(path, "cannot write PNG (" + failure.message +
+                                  (failure.error ? std::string(": ") + std::strerror(failure.error) : "") + ")");
         }
         png_init_io(png, fp);
         png_set_IHDR(png, info, width, height, 8, PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE,
@@ -172,11 +210,18 @@ void writePngRgb8(const std::string& path, int width, int height, const std::vec
         for (int y = 0; y < height; ++y) png_write_row(png, (png_const_bytep)&rgb[size_t(y) * width * 3]);
         png_write_end(png, nullptr);
         png_destroy_write_struct(&png, &info);
-        if (std::fclose(fp) != 0) throw Error(path, "cannot finish writing");
+        if (std::fclose(fp) != 0) throw Error(path, std::string("cannot finish writing: ") + std::strerror(errno));
     });
 }
 
-unsigned char toByte(float encoded) { return (unsigned char)std::clamp(int(encoded * 255.f + 0.5f), 0, 255); }
+/// [0, 1] -> 0..255; NaN maps to 0 and the infinities to the nearer end. (Converting them to
+/// int first, as the clamp after the conversion once did, is undefined behaviour: UBSan's
+/// float-cast-overflow on a render's NaN pixels.) Finite values map as they always did.
+unsigned char toByte(float encoded) {
+    if (!(encoded > 0.f)) return 0;  // NaN too
+    if (encoded >= 1.f) return 255;
+    return (unsigned char)(encoded * 255.f + 0.5f);
+}
 
 }  // namespace
 
@@ -215,16 +260,8 @@ Image3f readPng(const std::string& path) {
         std::fclose(fp);
         throw Error(path, "not a PNG file");
     }
-    // libpng prints its errors to stderr by default ("libpng error: Read Error" before wedge's
-    // own message); this handler keeps the text for wedge's message instead, and drops warnings.
-    struct Failure {
-        std::string message;
-    } failure;
-    auto onError = [](png_structp p, png_const_charp message) {
-        static_cast<Failure*>(png_get_error_ptr(p))->message = message;
-        png_longjmp(p, 1);
-    };
-    png_structp png = png_create_read_struct(PNG_LIBPNG_VER_STRING, &failure, onError, [](png_structp, png_const_charp) {});
+    PngFailure failure;
+    png_structp png = png_create_read_struct(PNG_LIBPNG_VER_STRING, &failure, onPngError, onPngWarning);
     png_infop info = png_create_info_struct(png);
     std::vector<unsigned char> pixels;
     std::vector<png_bytep> rows;
@@ -240,6 +277,12 @@ Image3f readPng(const std::string& path) {
     // damaged or hostile header could ask for terabytes (libpng allows 1,000,000 per side).
     // (The message lives in the if's scope only: libpng's later errors longjmp past this point.)
     if (const std::string why = oversize("PNG", png_get_image_width(png, info), png_get_image_height(png, info));
+        !why.empty()) {
+        png_destroy_read_struct(&png, &info, nullptr);
+        std::fclose(fp);
+        throw Error(path, why);
+    }
+    if (const std::string why = overMemory("PNG", png_get_image_width(png, info), png_get_image_height(png, info), 3);
         !why.empty()) {
         png_destroy_read_struct(&png, &info, nullptr);
         std::fclose(fp);
@@ -304,6 +347,11 @@ Image3f readJpeg(const std::string& path) {
         std::fclose(fp);
         throw Error(path, why);
     }
+    if (const std::string why = overMemory("JPEG", jpeg.image_width, jpeg.image_height, 3); !why.empty()) {
+        jpeg_destroy_decompress(&jpeg);
+        std::fclose(fp);
+        throw Error(path, why);
+    }
     if (jpeg.jpeg_color_space == JCS_CMYK || jpeg.jpeg_color_space == JCS_YCCK) {
         jpeg_destroy_decompress(&jpeg);
         std::fclose(fp);
@@ -342,7 +390,8 @@ void writePfm(const std::string& path, const Image3f& img) {
                 float rgb[3] = {img(x, y).x, img(x, y).y, img(x, y).z};
                 out.write(reinterpret_cast<const char*>(rgb), sizeof(rgb));
             }
-        if (!out) throw Error(path, "write failed");
+        out.close();  // the last buffer reaches the disk here
+        if (!out) throw Error(path, std::string("cannot write PFM: ") + std::strerror(errno));
     });
 }
 
@@ -366,6 +415,7 @@ Image3f readPfm(const std::string& path) {
     in.seekg(dataStart);
     if (uint64_t(w) * uint64_t(h) * channels * sizeof(float) > available)
         throw Error(path, "truncated PFM data (the header gives " + std::to_string(w) + "x" + std::to_string(h) + ")");
+    if (const std::string why = overMemory("PFM", uint64_t(w), uint64_t(h), channels * sizeof(float)); !why.empty()) throw Error(path, why);
     std::vector<float> raw(size_t(w) * h * channels);
     in.read(reinterpret_cast<char*>(raw.data()), raw.size() * sizeof(float));
     if (!in) throw Error(path, "truncated PFM data");

@@ -14,6 +14,7 @@
 #include "core/sampler.h"
 #include "io/image_io.h"
 #include "io/plot.h"
+#include "io/output_file.h"
 #include "io/text_file.h"
 
 namespace fs = std::filesystem;
@@ -98,22 +99,6 @@ uint64_t sceneHash(const scene::SceneDesc& d) {
     h = fnv1a(c.position, fnv1a(c.lookAt, fnv1a(c.up, h)));
     for (float v : {c.fovY, c.apertureRadius, c.focusDistance, c.shutterOpen, c.shutterClose}) h = fnv1a(v, h);
     return fnv1a(d.render.indirect ? "indirect" : "direct", h);
-}
-
-void writeTextFile(const std::string& path, const std::string& text) {
-    std::string tmp = path + ".tmp" + std::to_string(getpid());
-    {
-        std::ofstream out(tmp, std::ios::binary);
-        if (!out) throw Error(path, "cannot open for writing");
-        out << text;
-        if (!out) throw Error(path, "write failed");
-    }
-    std::error_code ec;
-    fs::rename(tmp, path, ec);
-    if (ec) {
-        fs::remove(tmp, ec);
-        throw Error(path, "cannot write");
-    }
 }
 
 std::string base64(const std::string& bytes) {
@@ -252,7 +237,7 @@ void Experiment::loadOrRenderReference() {
     j["seed"] = m_result.referenceSeed;
     j["seconds"] = m_result.referenceSeconds;
     j["noise_relmse"] = m_result.referenceNoise;
-    writeTextFile(meta.string(), j.dump(2) + "\n");
+    io::writeTextFile(meta.string(), j.dump(2) + "\n");
 }
 
 const ExperimentProbe* Experiment::evaluate(const std::string& method, int spp) {
@@ -434,7 +419,7 @@ ExperimentResult Experiment::run() {
     writeImages();
     writeResultsJson();
     std::string table = markdownTable();
-    writeTextFile((fs::path(m_options.outDir) / "table.md").string(), table);
+    io::writeTextFile((fs::path(m_options.outDir) / "table.md").string(), table);
     writeHtml();
     if (!m_options.quiet) std::fputs(table.c_str(), stdout);
     say("wrote " + (fs::path(m_options.outDir) / "index.html").string());
@@ -548,7 +533,7 @@ void Experiment::writeResultsJson() const {
         }
         rows.push_back(j);
     }
-    writeTextFile((fs::path(m_options.outDir) / "results.json").string(), rows.dump(2) + "\n");
+    io::writeTextFile((fs::path(m_options.outDir) / "results.json").string(), rows.dump(2) + "\n");
 }
 
 /// The Fig. 12 layout as Markdown: the base rows with their stage times, then each method's
@@ -857,7 +842,7 @@ void Experiment::writeHtml() const {
         h << "</table>\n";
     }
     h << "</body></html>\n";
-    writeTextFile((out / "index.html").string(), h.str());
+    io::writeTextFile((out / "index.html").string(), h.str());
 }
 
 }  // namespace
