@@ -5,7 +5,7 @@ BUILD ?= build
 JOBS  ?= $(shell nproc)
 CMAKE_FLAGS ?=
 
-.PHONY: all deps configure build demo test bench clean
+.PHONY: all deps configure build demo test test-sanitize fuzz fuzz-smoke bench clean
 
 all: build
 
@@ -25,9 +25,31 @@ demo: build
 test: build
 	@cd $(BUILD) && ctest --output-on-failure -j $(JOBS)
 
+# The whole suite under ASan + UBSan (clang; the first finding aborts its test, leaks included).
+SANITIZE_BUILD ?= build-sanitize
+export ASAN_OPTIONS ?= detect_leaks=1:abort_on_error=0:strict_string_checks=1:detect_stack_use_after_return=1
+export UBSAN_OPTIONS ?= print_stacktrace=1:halt_on_error=1
+test-sanitize: deps
+	@cmake -S . -B $(SANITIZE_BUILD) -DCMAKE_BUILD_TYPE=Release -DCMAKE_CXX_COMPILER=clang++ \
+	  -DWEDGE_SANITIZE=ON $(CMAKE_FLAGS) >/dev/null
+	@cmake --build $(SANITIZE_BUILD) -j $(JOBS)
+	@cd $(SANITIZE_BUILD) && WEDGE_SANITIZED=1 ctest --output-on-failure -j $(JOBS)
+
+# libFuzzer targets (fuzz/README.md): build-fuzz/fuzz/fuzz_<target>.
+FUZZ_BUILD ?= build-fuzz
+FUZZ_SECONDS ?= 25
+fuzz: deps
+	@cmake -S . -B $(FUZZ_BUILD) -DCMAKE_BUILD_TYPE=Release -DCMAKE_CXX_COMPILER=clang++ \
+	  -DWEDGE_FUZZ=ON $(CMAKE_FLAGS) >/dev/null
+	@cmake --build $(FUZZ_BUILD) -j $(JOBS) --target fuzz_targets
+
+# CI's short pass: each target for FUZZ_SECONDS.
+fuzz-smoke: fuzz
+	@bench/fuzz.sh $(FUZZ_SECONDS)
+
 bench: build
 	$(BUILD)/bench/wedge_bench --benchmark_counters_tabular=true
 	WEDGE_EXTRAS=1 scripts/install-deps.sh && bench/pathtracer_peer.sh $(BUILD)
 
 clean:
-	rm -rf $(BUILD) out
+	rm -rf $(BUILD) $(SANITIZE_BUILD) $(FUZZ_BUILD) out

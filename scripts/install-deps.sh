@@ -9,10 +9,14 @@ packages=(
   nlohmann-json3-dev libcli11-dev libfftw3-dev libgtest-dev libbenchmark-dev
   chromium
   python3-dev pybind11-dev python3-numpy python3-pytest python3-matplotlib
+  clang libclang-rt-14-dev llvm
 )
 # chromium: the headless browser the experiment-report test screenshots (tests/experiment_test.cpp).
 # python3-dev, pybind11-dev: the Python module (python/); numpy for its arrays; pytest runs its
 # tests under ctest; matplotlib draws the figures of examples/.
+# clang, libclang-rt-14-dev (its sanitizer and libFuzzer runtimes; only recommended by clang, and
+# recommends are not installed here) and llvm (llvm-symbolizer, for the sanitizers' stack
+# traces): `make test-sanitize` and `make fuzz`.
 # Optional extras: `WEDGE_EXTRAS=1` adds Embree's path tracer used as the throughput peer in bench/.
 if [[ "${WEDGE_EXTRAS:-0}" == 1 ]]; then
   packages+=(embree-tools)
