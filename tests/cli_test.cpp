@@ -473,3 +473,15 @@ TEST(Cli, AFailedWriteIsAnErrorAndKeepsThePreviousOutput) {
     EXPECT_EQ(runWedge("render " + dir + "/good.json --quiet -o /proc/wedge-test.exr", nullptr, &err), 2);
     EXPECT_NE(err.find("/proc/wedge-test.exr: "), std::string::npos) << err;
 }
+
+TEST(Cli, ARenderTooLargeForTheMemoryLimitIsRefusedBeforeItStarts) {
+    std::string dir = tempDir(), err;
+    writeFile(dir + "/good.json", scene(kSphere));
+    EXPECT_EQ(runWedge("render " + dir + "/good.json --resolution 16384x16384 --quiet -o " + dir + "/a.png", nullptr, &err), 2);
+    EXPECT_NE(err.find("good.json: a 16384x16384 mc render needs 300.0 GiB, more than the memory limit of"), std::string::npos) << err;
+    EXPECT_EQ(runWedge("render " + dir + "/good.json --method maaf --quiet --max-memory 64K -o " + dir + "/a.png", nullptr, &err), 2);
+    EXPECT_NE(err.find("a 8x8 maaf render needs 75.0 KiB, more than the memory limit of 64.0 KiB (--max-memory)"), std::string::npos)
+        << err;
+    EXPECT_FALSE(fs::exists(dir + "/a.png"));
+    EXPECT_EQ(runWedge("render " + dir + "/good.json --method maaf --quiet --max-memory 1G -o " + dir + "/a.png", nullptr, &err), 0) << err;
+}
