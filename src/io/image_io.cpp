@@ -157,7 +157,7 @@ ExrImage readExr(const std::string& path) {
         Imf::FrameBuffer fb;
         for (auto it = list.begin(); it != list.end(); ++it) {
             auto& v = img.channels[it.name()];
-            v.assign(size_t(w) * size_t(h), 0.f);
+            v.resize(size_t(w) * size_t(h));  // unwritten until OpenEXR reads the lines
             // Slice::Make places the window's origin without pointer arithmetic outside the buffer.
             fb.insert(it.name(), Imf::Slice::Make(Imf::FLOAT, v.data(), dw, sizeof(float), sizeof(float) * size_t(w)));
         }

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "core/image.h"
+#include "core/memory.h"
 
 namespace wedge::io {
 
@@ -23,7 +24,9 @@ void writeExr(const std::string& path, int width, int height, const std::vector<
 
 struct ExrImage {
     int width = 0, height = 0;
-    std::map<std::string, std::vector<float>> channels;
+    /// Allocated unwritten (core/memory.h): the reader writes every float, and a file that
+    /// ends early fails having touched only the lines it read, not the header's whole size.
+    std::map<std::string, std::vector<float, UnwrittenAllocator<float>>> channels;
 };
 ExrImage readExr(const std::string& path);
 
