@@ -13,6 +13,8 @@ shift
 targets=("$@")
 [[ ${#targets[@]} -eq 0 ]] && targets=(scene obj png jpeg exr pfm compare)
 build=${FUZZ_BUILD:-build-fuzz}
+# The targets write each input's files to a scratch folder (fuzz/targets.h): memory, not disk.
+[[ -d /dev/shm && -w /dev/shm ]] && export TMPDIR=${TMPDIR:-/dev/shm}
 
 found=0
 printf '%-8s %8s %12s %10s %9s\n' target seconds executions 'exec/s' findings
