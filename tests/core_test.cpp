@@ -4,7 +4,9 @@
 #include <zlib.h>
 
 #include <atomic>
+#include <cerrno>
 #include <climits>
+#include <cstring>
 #include <cmath>
 #include <filesystem>
 #include <limits>
@@ -17,6 +19,7 @@
 #include "core/memory_limit.h"
 #include "core/sampler.h"
 #include "io/image_io.h"
+#include "io/text_file.h"
 #include "render/output.h"
 #include "test_util.h"
 
@@ -275,6 +278,18 @@ TEST(ImageIo, ExrHeadersAreCheckedBeforeAllocating) {
     // The same file within the limit is read, and refused for what it is: lines that are not there.
     const std::string missing = readError(dir + "/deep.exr");
     EXPECT_NE(missing.find("not a readable EXR file"), std::string::npos) << missing;
+}
+
+TEST(ImageIo, PathsTheFileSystemRefusesAreErrorsNotExceptions) {
+    // A name over NAME_MAX made std::filesystem::is_regular_file throw past wedge's errors
+    // (fuzz_obj: a 4 KB map_Kd name; the CLI said "internal error" and exited 1).
+    const std::string dir = test::tempDir(), longName = dir + "/" + std::string(300, 'x') + ".png";
+    EXPECT_EQ(io::notARegularFile(longName), std::string(std::strerror(ENAMETOOLONG)));
+    EXPECT_EQ(io::notARegularFile(dir + "/missing.png"), "no such file");
+    EXPECT_EQ(io::notARegularFile(dir), "is a directory");
+    EXPECT_NE(readError(longName).find(longName + ": File name too long"), std::string::npos) << readError(longName);
+    test::writeFile(dir + "/a.txt", "x");
+    EXPECT_EQ(io::notARegularFile(dir + "/a.txt"), "");
 }
 
 TEST(ImageIo, TheMemoryLimitCoversEveryReader) {

@@ -49,16 +49,13 @@ TEST(FuzzRegressions, SeedsAreReadAndSomeAreAccepted) {
     }
 }
 
-TEST(FuzzRegressions, FindingsAreRefusedCleanly) {
+TEST(FuzzRegressions, FindingsEndInAnErrorOrAResultNotACrash) {
+    // Each was a crash, a hang, a sanitizer report or an exception other than wedge::Error;
+    // replay() fails on any of those. (Some are refused, some load: a map_Kd whose name is too
+    // long for the file system is a texture not rendered, named in a warning.)
     int files = 0;
-    for (const fuzz::Target& t : fuzz::targets()) {
-        SCOPED_TRACE(t.name);
-        const Replay r = replay(t, kFuzzDir / "regressions" / t.name);
-        files += r.files;
-        // A regression input is one wedge must refuse (each was a crash, a hang or a report).
-        EXPECT_EQ(r.accepted, 0);
-    }
-    EXPECT_GE(files, 1) << "fuzz/regressions/ holds the findings (docs/reliability.md)";
+    for (const fuzz::Target& t : fuzz::targets()) files += replay(t, kFuzzDir / "regressions" / t.name).files;
+    EXPECT_GE(files, 5) << "fuzz/regressions/ holds the findings (docs/reliability.md)";
 }
 
 TEST(FuzzRegressions, AnInputCarriesNamedFiles) {

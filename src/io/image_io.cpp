@@ -27,6 +27,7 @@
 #include "core/memory_limit.h"
 #include "core/parallel.h"
 #include "io/output_file.h"
+#include "io/text_file.h"
 
 namespace fs = std::filesystem;
 
@@ -68,7 +69,8 @@ void checkOutputPath(const std::string& path, const std::vector<std::string>& al
         throw Error(path, "unsupported output format '" + e + "' (expected " + list + ")");
     }
     fs::path dir = fs::path(path).parent_path();
-    if (!dir.empty() && !fs::is_directory(dir)) throw Error(path, "output directory does not exist");
+    std::error_code ec;
+    if (!dir.empty() && !fs::is_directory(dir, ec)) throw Error(path, "output directory does not exist");
 }
 
 float srgbEncode(float v) {
@@ -128,7 +130,7 @@ void writeExr(const std::string& path, int width, int height, const std::vector<
 }
 
 ExrImage readExr(const std::string& path) {
-    if (!fs::is_regular_file(path)) throw Error(path, "no such file");
+    if (const std::string why = notARegularFile(path); !why.empty()) throw Error(path, why);
     // OpenEXR allocates from the header as it opens a file (an offset per line block: 1 GB for a
     // window 2^31 lines high) unless told the largest image and tile to accept; the library's own
     // guard against damaged files, set to what wedge renders at most.
@@ -431,7 +433,7 @@ Image3f readPfm(const std::string& path) {
 // --- by extension ----------------------------------------------------------------------------
 
 Image3f readColor(const std::string& path) {
-    if (!fs::is_regular_file(path)) throw Error(path, "no such file");
+    if (const std::string why = notARegularFile(path); !why.empty()) throw Error(path, why);
     std::string e = extension(path);
     if (e == ".png") return readPng(path);
     if (e == ".pfm") return readPfm(path);

@@ -26,7 +26,7 @@ JsonNode::JsonNode(const nlohmann::json& value, std::string file, std::string pa
     : m_value(value), m_file(std::move(file)), m_path(std::move(path)) {}
 
 nlohmann::json JsonNode::parseFile(const std::string& file) {
-    if (std::filesystem::is_directory(file)) throw Error(file, "is a directory, expected a JSON scene file");
+    if (notARegularFile(file) == "is a directory") throw Error(file, "is a directory, expected a JSON scene file");
     return parseText(readTextFile(file), file);
 }
 

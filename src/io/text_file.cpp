@@ -8,9 +8,18 @@
 
 namespace wedge::io {
 
+std::string notARegularFile(const std::string& path) {
+    std::error_code ec;
+    const auto status = std::filesystem::status(path, ec);
+    if (status.type() == std::filesystem::file_type::not_found) return "no such file";
+    if (ec) return ec.message();
+    if (status.type() == std::filesystem::file_type::directory) return "is a directory";
+    if (status.type() != std::filesystem::file_type::regular) return "not a regular file";
+    return "";
+}
+
 std::string readTextFile(const std::string& file) {
-    if (!std::filesystem::exists(file)) throw Error(file, "no such file");
-    if (std::filesystem::is_directory(file)) throw Error(file, "is a directory");
+    if (const std::string why = notARegularFile(file); !why.empty()) throw Error(file, why);
     std::ifstream in(file, std::ios::binary);
     if (!in) throw Error(file, "cannot open for reading");
     std::ostringstream text;

@@ -408,8 +408,9 @@ std::shared_ptr<const TextureMap> diffuseMap(const std::string& objPath, const s
         notRendered.push_back("'" + m.name + "' (map_Kd '" + name + "': wedge reads PNG and JPEG textures)");
         return nullptr;
     }
-    if (!fs::is_regular_file(file)) {
-        notRendered.push_back("'" + m.name + "' (map_Kd '" + file.string() + "' does not exist)");
+    if (const std::string why = io::notARegularFile(file.string()); !why.empty()) {
+        notRendered.push_back("'" + m.name + "' (map_Kd '" + file.string() +
+                              (why == "no such file" ? "' does not exist)" : "': " + why + ")"));
         return nullptr;
     }
     const tinyobj::texture_option_t& o = m.diffuse_texopt;
@@ -500,7 +501,8 @@ std::vector<uint32_t> appendMtlMaterials(const std::string& path, const std::str
 
 void loadObj(const std::string& path, const std::string& where, int overrideMaterial, std::vector<Material>& materials,
              TriangleMesh& mesh, std::vector<AreaLight>& promoted, std::vector<std::string>& warnings) {
-    if (!fs::is_regular_file(path)) throw Error(where, "mesh file '" + path + "' does not exist");
+    if (const std::string why = io::notARegularFile(path); !why.empty())
+        throw Error(where, "mesh file '" + path + (why == "no such file" ? "' does not exist" : "': " + why));
     tinyobj::ObjReader reader;
     std::vector<MtlColours> mtlColours;
     parseObjChecked(path, where, reader, mtlColours, warnings);
@@ -700,7 +702,8 @@ std::vector<BuiltinScene> builtinScenes() {
 
 SceneDesc loadScene(const std::string& pathOrName) {
     std::string file = pathOrName;
-    if (!fs::exists(file) && file.find('/') == std::string::npos && fs::path(file).extension().empty()) {
+    std::error_code ec;
+    if (!fs::exists(file, ec) && file.find('/') == std::string::npos && fs::path(file).extension().empty()) {
         bool found = false;
         std::string names;
         for (const auto& b : builtinScenes()) {
