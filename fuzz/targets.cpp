@@ -82,25 +82,17 @@ bool objMtl(const uint8_t* data, size_t size) {
     });
 }
 
-bool png(const uint8_t* data, size_t size) {
-    const auto paths = serve(data, size, "a.png");
-    return refusing([&] { io::readPng(paths[0]); });
+/// One image file, named `name` (its format), through `read`.
+template <class Read>
+bool imageFile(const uint8_t* data, size_t size, const char* name, Read read) {
+    const auto paths = serve(data, size, name);
+    return refusing([&] { read(paths[0]); });
 }
 
-bool jpeg(const uint8_t* data, size_t size) {
-    const auto paths = serve(data, size, "a.jpg");
-    return refusing([&] { io::readJpeg(paths[0]); });
-}
-
-bool exr(const uint8_t* data, size_t size) {
-    const auto paths = serve(data, size, "a.exr");
-    return refusing([&] { io::readExr(paths[0]); });
-}
-
-bool pfm(const uint8_t* data, size_t size) {
-    const auto paths = serve(data, size, "a.pfm");
-    return refusing([&] { io::readPfm(paths[0]); });
-}
+bool png(const uint8_t* data, size_t size) { return imageFile(data, size, "a.png", io::readPng); }
+bool jpeg(const uint8_t* data, size_t size) { return imageFile(data, size, "a.jpg", io::readJpeg); }
+bool exr(const uint8_t* data, size_t size) { return imageFile(data, size, "a.exr", io::readExr); }
+bool pfm(const uint8_t* data, size_t size) { return imageFile(data, size, "a.pfm", io::readPfm); }
 
 /// `wedge compare TEST REF --json` as the command line runs it; REF is the input's second file
 /// (its name gives its format), or TEST itself.
