@@ -11,12 +11,14 @@
 
 #include "core/error.h"
 #include "core/light_field.h"
+#include "core/memory_limit.h"
 #include "filter/layers.h"
 #include "metrics/metrics.h"
 #include "render/camera.h"
 #include "render/renderer.h"
 #include "scene/scene.h"
 #include "scene/scene_loader.h"
+#include "test_util.h"
 
 using namespace wedge;
 
@@ -278,6 +280,14 @@ TEST(Layers, AutoReconstructsForMonteCarloAndAtrousAndABadValueIsAnError) {
     high.spp = render::RenderOptions::kLayersAutoSpp + 1;
     high.quiet = true;
     EXPECT_FALSE(render::render(scene::Scene(parse(kDefocusedEdge)), high).figure("layers_sample_bytes").has_value());
+    // More samples than the memory limit holds: refused before they are allocated.
+    high.layers = "on";
+    high.spp = 2000;  // 96 x 24 x 2000 x 24 bytes: 110 MB
+    setMemoryLimit(uint64_t(64) << 20);
+    const std::string message = test::errorOf([&] { render::render(scene::Scene(parse(kDefocusedEdge)), high); });
+    setMemoryLimit(0);
+    EXPECT_NE(message.find("--layers"), std::string::npos) << message;
+    EXPECT_NE(message.find("memory limit"), std::string::npos) << message;
     render::RenderOptions o;
     o.layers = "maybe";
     scene::Scene s(parse(kDefocusedEdge));

@@ -16,10 +16,12 @@
 #include <bit>
 #include <cmath>
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "core/image.h"
 #include "core/memory.h"
+#include "core/memory_limit.h"
 
 namespace wedge {
 
@@ -102,6 +104,8 @@ public:
     bool empty() const { return m_stages.empty(); }
 
     /// Adds a stage with count(p) samples for pixel p (row-major index); returns its index.
+    /// Throws wedge::Error (naming --layers) before allocating when the samples kept so far and
+    /// the stage's would pass the memory limit (core/memory_limit.h).
     template <class CountFn>
     int addStage(CountFn&& count) {
         Stage s;
@@ -109,6 +113,8 @@ public:
         s.offset.resize(pixels + 1);
         s.offset[0] = 0;
         for (size_t p = 0; p < pixels; ++p) s.offset[p + 1] = s.offset[p] + count(p);
+        checkMemory("--layers", "keeping every sample (" + std::to_string(s.offset[pixels] + samples()) + " at 24 bytes)",
+                    uint64_t(bytes() + s.offset[pixels] * sizeof(LightFieldSample)));
         s.samples = LargeVector<LightFieldSample>(s.offset[pixels]);
         m_stages.push_back(std::move(s));
         return int(m_stages.size()) - 1;
@@ -133,6 +139,11 @@ public:
     size_t count(size_t p) const {
         size_t n = 0;
         for (const Stage& s : m_stages) n += s.offset[p + 1] - s.offset[p];
+        return n;
+    }
+    size_t samples() const {
+        size_t n = 0;
+        for (const Stage& s : m_stages) n += s.samples.size();
         return n;
     }
     size_t bytes() const {
