@@ -17,6 +17,10 @@ build=${FUZZ_BUILD:-build-fuzz}
 [[ -d /dev/shm && -w /dev/shm ]] && export TMPDIR=${TMPDIR:-/dev/shm}
 
 found=0
+# Findings of this run only: those of earlier runs stay in build-fuzz/findings/ until they are
+# moved to fuzz/regressions/, and counting them made every later run fail.
+stamp=$(mktemp)
+trap 'rm -f "$stamp"' EXIT
 printf '%-8s %8s %12s %10s %9s\n' target seconds executions 'exec/s' findings
 for t in "${targets[@]}"; do
   bin=$build/fuzz/fuzz_$t
@@ -31,7 +35,7 @@ for t in "${targets[@]}"; do
   "$bin" "$corpus" "${dict[@]}" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2560 \
     -artifact_prefix="$findings"/ -print_final_stats=1 >"$log" 2>&1 || rc=$?
   execs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -1)
-  n=$(find "$findings" -type f | wc -l)
+  n=$(find "$findings" -type f -newer "$stamp" | wc -l)
   [[ $rc -ne 0 || $n -gt 0 ]] && found=1
   printf '%-8s %8s %12s %10s %9s\n' "$t" "$seconds" "${execs:-0}" "$(( ${execs:-0} / seconds ))" "$n"
 done
