@@ -84,7 +84,7 @@ void renderMaaf(const MethodContext& ctx, RenderResult& result) {
     // here: in fresh processes started 4 s apart (so that the pages freed before had gone back to
     // the hypervisor), tracing again was faster on five of the six 512x512 scenes (cornell 3.0-3.2 s
     // against 3.5 s, bunny 3.6-3.7 s against 4.0-4.6 s) and level on sponza (8.1 s against
-    // 7.4-8.0 s), with 118-137 MB less at the peak (README, "MAAF's sample records").
+    // 7.4-8.0 s), with 118-137 MB less at the peak (docs/maaf.md, "MAAF's sample records").
     const bool retrace = !ctx.options.maafKeepRecords;
     const size_t initialRecordBytes = pixels * n0 * sizeof(filter::MaafSample);
     checkMemory(accBytes + otherBytes + (retrace ? 0 : initialRecordBytes),
@@ -157,7 +157,7 @@ void renderMaaf(const MethodContext& ctx, RenderResult& result) {
         // sample by the cos / sin of its own light, bounce and lens coordinates (eq. 23), so
         // their estimate of the sheared spectrum is as noisy as the pixel's few samples, and
         // those pixels (a few percent: sharp shadows, contact edges, corners) are where 16
-        // samples fall short. Measured at 512x512 against 1024-spp references (README,
+        // samples fall short. Measured at 512x512 against 1024-spp references (docs/maaf.md,
         // "Adaptive samples where the outer components are"), relMSE and average spp, paper's
         // rule -> this: cornell 0.000105 at 18.8 -> 0.0000942 at 19.6, conference 0.000659 at
         // 22.2 -> 0.000628 at 23.5, sponza 0.000937 at 33.5 -> 0.000864 at 35.0, grids

@@ -22,7 +22,7 @@ struct RenderOptions {
     // aaf/maaf: at most this many adaptive samples per pixel after the initial ones. The papers
     // cap at 100 (AAF 2013, MAAF Sec. 6.2); 16 is the measured optimum of the efficiency
     // 1 / (relMSE x seconds) on cornell, conference, sponza and grids at their own resolutions
-    // (README, "Adaptive sampling cap"): beyond it the samples cost more time than they remove error.
+    // (docs/measurements.md, "Adaptive sampling cap"): beyond it the samples cost more time than they remove error.
     static constexpr int kDefaultMaxExtraSpp = 16;
     int maxExtraSpp = kDefaultMaxExtraSpp;
     int maafComponents = 5;          // 2N-1 filters per 2D/3D subspace
