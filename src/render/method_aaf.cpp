@@ -78,8 +78,8 @@ void renderAaf(const MethodContext& ctx, RenderResult& result) {
     Image3f visibility =
         filter::aafFilter(visibilityImage(fb), params.omegaDirect, fb, frames.direct, ao, &fb.unoccluded);
     Image3f indirect = filter::aafFilter(fb.indirect, params.omegaIndirect, fb, frames.indirect, ao);
-    result.seconds.add("filter", t.seconds());  // the layered reconstruction, if any, is timed apart
     result.color = composeFilteredLight(ctx, visibility, indirect, result);
+    result.seconds.add("filter", t.seconds() - result.seconds.get("layers"));  // the layered reconstruction is its own stage
 
     if (!ctx.options.aovDir.empty()) {
         const std::string& dir = ctx.options.aovDir;

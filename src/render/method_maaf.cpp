@@ -305,14 +305,11 @@ void renderMaaf(const MethodContext& ctx, RenderResult& result) {
     Image3f indirect = accIndirect.filter(params.indirect, fb, frames.indirect, fb.indirect, mo);
     result.seconds.add("filter_indirect", part.seconds());
     part.reset();
-    if (ctx.lightField) {
-        result.seconds.add("filter", t.seconds());  // the layered reconstruction is timed apart
-        result.color = composeFilteredLight(ctx, visibility, indirect, result);
-    } else {
-        result.color = composeFilteredLight(ctx, visibility, indirect, result);
-        result.seconds.add("filter_compose", part.seconds());  // remodulation and the defocus filter
-        result.seconds.add("filter", t.seconds());
-    }
+    result.color = composeFilteredLight(ctx, visibility, indirect, result);
+    // Remodulation and the defocus filter; the layered reconstruction, if any, is its own stage.
+    const double layers = result.seconds.get("layers");
+    result.seconds.add("filter_compose", part.seconds() - layers);
+    result.seconds.add("filter", t.seconds() - layers);
 
     if (!ctx.options.aovDir.empty()) {
         const std::string& dir = ctx.options.aovDir;
