@@ -65,6 +65,12 @@ struct Layer {
     // R, G, B (resolved); last, the layer's own slope there (a slanted surface's changes across
     // the tile, which the rays follow).
     std::vector<float> acc, cell;
+    /// Summed-area table of the cells with alpha > 0 ((gw + 1) x (gh + 1)): a pixel whose rays
+    /// can reach only uncovered cells skips the layer (exactly: it would add nothing there).
+    std::vector<int> covered;
+    /// How far (pixels) a ray's lookups can land from the pixel: the largest slope (the rays
+    /// follow the slope they find, never beyond the layer's extremes) and half the motion.
+    float rayReach = 0;
     int accStride() const { return 3 + 4 * timeBins; }   // ... and last the sum of the samples' slopes
     int cellStride() const { return 2 + 3 * timeBins; }  // ... and last the samples' mean slope there
 
@@ -78,6 +84,30 @@ struct Layer {
         return i < 0 || j < 0 || i >= gw || j >= gh ? -1 : j * gw + i;
     }
     int timeBin(float t) const { return std::min(timeBins - 1, int(t * float(timeBins))); }
+
+    void buildCovered() {
+        const int cs = cellStride();
+        covered.assign(size_t(gw + 1) * (gh + 1), 0);
+        for (int j = 0; j < gh; ++j) {
+            int row = 0;
+            for (int i = 0; i < gw; ++i) {
+                row += cell[(size_t(j) * gw + i) * cs] > 0.f ? 1 : 0;
+                covered[size_t(j + 1) * (gw + 1) + i + 1] = covered[size_t(j) * (gw + 1) + i + 1] + row;
+            }
+        }
+    }
+    /// Whether any covered cell can be read by a lookup of pixel (x, y)'s rays: bilinear lookups
+    /// within rayReach of the pixel's square, a sharp layer's at the pixel's own cell.
+    bool reaches(int x, int y) const {
+        const float r = sharp ? 0.f : rayReach;
+        const int i0 = std::max(0, int(std::floor(float(x - gx0) - r)) - 1);
+        const int i1 = std::min(gw - 1, int(std::ceil(float(x + 1 - gx0) + r)) + 1);
+        const int j0 = std::max(0, int(std::floor(float(y - gy0) - r)) - 1);
+        const int j1 = std::min(gh - 1, int(std::ceil(float(y + 1 - gy0) + r)) + 1);
+        if (i0 > i1 || j0 > j1) return false;
+        const size_t s = size_t(gw + 1);
+        return covered[(j1 + 1) * s + i1 + 1] - covered[j0 * s + i1 + 1] - covered[(j1 + 1) * s + i0] + covered[j0 * s + i0] > 0;
+    }
 };
 
 /// Splits the tile's samples into layers, front to back (see layers.h, step 1); sets
@@ -281,6 +311,28 @@ struct Lookup {
     Vec3f premultiplied{0.f};
     float slope = 0;
 };
+/// The bilinear cells and weights of a blurred layer's lookup at p (see lookup()).
+struct Bilinear {
+    int cell[4];
+    float w[4];
+};
+Bilinear bilinear(const Layer& l, Vec2f p) {
+    const float fx = std::clamp(p.x - float(l.gx0) - 0.5f, 0.f, float(l.gw - 1));
+    const float fy = std::clamp(p.y - float(l.gy0) - 0.5f, 0.f, float(l.gh - 1));
+    const int i0 = std::min(int(fx), std::max(0, l.gw - 2)), j0 = std::min(int(fy), std::max(0, l.gh - 2));
+    const int i1 = std::min(i0 + 1, l.gw - 1), j1 = std::min(j0 + 1, l.gh - 1);
+    const float ax = fx - float(i0), ay = fy - float(j0);
+    return {{j0 * l.gw + i0, j0 * l.gw + i1, j1 * l.gw + i0, j1 * l.gw + i1},
+            {(1 - ax) * (1 - ay), ax * (1 - ay), (1 - ax) * ay, ax * ay}};
+}
+/// The layer's own slope at p alone (the rays' fixed-point step), as lookup(l, p, t).slope.
+float lookupSlope(const Layer& l, Vec2f p) {
+    const int cs = l.cellStride();
+    const Bilinear b = bilinear(l, p);
+    float slope = 0;
+    for (int k = 0; k < 4; ++k) slope += b.w[k] * l.cell[size_t(b.cell[k]) * cs + cs - 1];
+    return slope;
+}
 Lookup lookup(const Layer& l, Vec2f p, float t) {
     const int cs = l.cellStride();
     Lookup out;
@@ -292,6 +344,10 @@ Lookup lookup(const Layer& l, Vec2f p, float t) {
         out.alpha += w * c[0];
         out.slope += w * c[cs - 1];
         const float* r0 = c + 1 + 3 * b0;
+        if (b1 == b0) {  // a still layer (one bin), or the last bin's half
+            out.premultiplied += Vec3f(r0[0], r0[1], r0[2]) * w;
+            return;
+        }
         const float* r1 = c + 1 + 3 * b1;
         out.premultiplied += Vec3f(r0[0], r0[1], r0[2]) * (w * (1.f - at)) + Vec3f(r1[0], r1[1], r1[2]) * (w * at);
     };
@@ -299,15 +355,8 @@ Lookup lookup(const Layer& l, Vec2f p, float t) {
         accumulate((int(std::floor(p.y)) - l.gy0) * l.gw + (int(std::floor(p.x)) - l.gx0), 1.f);
         return out;
     }
-    const float fx = std::clamp(p.x - float(l.gx0) - 0.5f, 0.f, float(l.gw - 1));
-    const float fy = std::clamp(p.y - float(l.gy0) - 0.5f, 0.f, float(l.gh - 1));
-    const int i0 = std::min(int(fx), std::max(0, l.gw - 2)), j0 = std::min(int(fy), std::max(0, l.gh - 2));
-    const int i1 = std::min(i0 + 1, l.gw - 1), j1 = std::min(j0 + 1, l.gh - 1);
-    const float ax = fx - float(i0), ay = fy - float(j0);
-    accumulate(j0 * l.gw + i0, (1 - ax) * (1 - ay));
-    accumulate(j0 * l.gw + i1, ax * (1 - ay));
-    accumulate(j1 * l.gw + i0, (1 - ax) * ay);
-    accumulate(j1 * l.gw + i1, ax * ay);
+    const Bilinear b = bilinear(l, p);
+    for (int k = 0; k < 4; ++k) accumulate(b.cell[k], b.w[k]);
     return out;
 }
 
@@ -479,11 +528,22 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                     if (!l.sharp) smooth(l.acc, l.gw, l.gh, l.accStride(), l.sigma);
                     resolveCells(l, l.sharp ? 0.5f : 0.05f);
                     l.acc = std::vector<float>();
+                    l.buildCovered();
+                    l.rayReach = std::max({std::abs(l.cMin), std::abs(l.cMax), std::abs(l.rayC)}) +
+                                 0.5f * std::sqrt(l.rayMx * l.rayMx + l.rayMy * l.rayMy);
                 }
-
+                std::vector<const Layer*> active;
+                std::vector<Lookup> activeSharp;
+                // The rays' sequence before each pixel's shift: (j + 1) k_d modulo 1.
+                float kron[64][5];
+                const int rays = anyBlurred ? std::min(o.rays, 64) : 1;
+                for (int j = 0; j < rays; ++j)
+                    for (int d = 0; d < 5; ++d) {
+                        const double v = double(j + 1) * kKronecker[d];
+                        kron[j][d] = float(v - std::floor(v));
+                    }
 
                 // Reconstruction rays, composited front to back.
-                const int rays = anyBlurred ? o.rays : 1;
                 for (int y = Y0; y < Y1; ++y)
                     for (int x = X0; x < X1; ++x) {
                         // The rays: a 5D Kronecker sequence (the generalised golden ratio's powers,
@@ -498,14 +558,27 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                             rng.get4D(0, 0, a, b);
                             shift[0] = a.x, shift[1] = a.y, shift[2] = b.x, shift[3] = b.y, shift[4] = rng.get1D(0, 2);
                         }
+                        // The layers this pixel's rays can see (the others add nothing: the same
+                        // image; the stage 1.0-1.7x faster with the per-tile sequence and the
+                        // slope-only lookups, docs/layers.md).
+                        active.clear();
+                        activeSharp.clear();
+                        for (const Layer& l : layers)
+                            if (l.reaches(x, y)) {
+                                active.push_back(&l);
+                                // A sharp still layer is the same for every ray: its pixel's cell.
+                                activeSharp.push_back(l.sharp && l.timeBins == 1
+                                                          ? lookup(l, {float(x) + 0.5f, float(y) + 0.5f}, 0.5f)
+                                                          : Lookup{-1.f, Vec3f(0.f), 0.f});
+                            }
                         // (Stopping at 8 or 16 rays where every one ended whole on one layer cost
                         // AAF relMSE +12% / +2% on cornell, +21% / +6% on conference at 512x512.)
                         Vec3f sum(0.f);
                         for (int j = 0; j < rays; ++j) {
                             float q[5];
                             for (int d = 0; d < 5; ++d) {
-                                const double v = double(shift[d]) + double(j + 1) * kKronecker[d];
-                                q[d] = float(v - std::floor(v));
+                                const float v = shift[d] + kron[j][d];
+                                q[d] = v >= 1.f ? v - 1.f : v;
                             }
                             const Vec2f u = anyBlurred ? concentricDisc(q[2], q[3]) : Vec2f{0, 0};
                             const float px = float(x) + (anyBlurred ? q[0] : 0.5f);
@@ -513,16 +586,19 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                             const float dt = (anyBlurred ? q[4] : 0.5f) - 0.5f;
                             Vec3f c(0.f);
                             float trans = 1.f;
-                            for (const Layer& l : layers) {
+                            for (size_t a = 0; a < active.size(); ++a) {
+                                const Layer& l = *active[a];
                                 Lookup v;
-                                if (l.sharp) {  // a sharp layer is its pixels' own samples: the ray's pixel
+                                if (activeSharp[a].alpha >= 0) {
+                                    v = activeSharp[a];
+                                } else if (l.sharp) {  // a sharp layer is its pixels' own samples: the ray's pixel
                                     v = lookup(l, {float(x) + 0.5f, float(y) + 0.5f}, dt + 0.5f);
                                 } else {
                                     // The layer's shear, then the slope of the surface it finds
                                     // there (one fixed-point step), narrowed by the grid's blur.
                                     const Vec2f mo{l.rayMx * dt, l.rayMy * dt};
                                     const float cRay = l.cMax - l.cMin < kSlopeSpread ? l.rayC :
-                                        l.narrowed(lookup(l, {px + l.rayC * u.x - mo.x, py - l.rayC * u.y - mo.y}, 0.5f).slope);
+                                        l.narrowed(lookupSlope(l, {px + l.rayC * u.x - mo.x, py - l.rayC * u.y - mo.y}));
                                     v = lookup(l, {px + cRay * u.x - mo.x, py - cRay * u.y - mo.y}, dt + 0.5f);
                                 }
                                 c += v.premultiplied * trans;

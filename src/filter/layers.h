@@ -59,7 +59,7 @@ struct LayerOptions {
     float sigmaMin = 0.5f, sigmaMax = 2.f;
     float splitMin = 0.5f, splitScale = 0.15f;  // a layer's slopes spread at most max(splitMin, splitScale |c|)
     int maxLayers = 8;
-    int rays = 32;      // reconstruction rays per pixel where a tile has a blurred layer
+    int rays = 32;      // reconstruction rays per pixel where a tile has a blurred layer (at most 64)
     uint32_t seed = 0;  // of the reconstruction rays
 };
 
