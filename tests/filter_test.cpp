@@ -286,6 +286,32 @@ TEST(WedgeField, PrefilterKeepsOwnBounceDistancesWhereMostBouncesHit) {
     }
 }
 
+TEST(MaafComponents, FitKeepsTheCentralComponentsThreeSigmaInItsRadius) {
+    // Issue 28: the fit rule against the central Gaussian's actual width: maafComponents' sx
+    // times spatialScale, for the most components the rule allows, and two more.
+    for (float share : {0.40824829f, 1.f}) {
+        MaafOptions o;
+        o.fitShare = share;
+        const double fitRadius = share * o.maxRadius;
+        for (double step : {1.0, 0.37})
+            for (double omegaX = 0.05; omegaX < 12.0; omegaX *= 1.13) {
+                const int n = maafFitPairs(omegaX, step, o);
+                auto threeSigmaPixels = [&](int pairs) {
+                    WedgeShape w;
+                    w.sMin = 0.7;
+                    w.sMax = 1.3;
+                    w.omegaYMax = w.sMin * omegaX;  // Omega_y^max / s_min = Omega_x
+                    const double sx = maafComponents(pairs, w)[0].sx * o.spatialScale;
+                    return 3.0 / (sx * step);
+                };
+                if (n > 1) {
+                    EXPECT_LE(threeSigmaPixels(n), fitRadius * (1 + 1e-5)) << omegaX;
+                }
+                EXPECT_GT(threeSigmaPixels(n + 1), fitRadius * (1 - 1e-5)) << omegaX;
+            }
+    }
+}
+
 TEST(MaafComponents, OneComponentIsTheAxisAlignedFilterOfEq2) {
     WedgeShape w;
     w.omegaYMax = 4;
@@ -503,6 +529,59 @@ TEST(MaafFilter, MirrorsSurfaceCutsSoThatAGradientStaysUnbiased) {
                 EXPECT_LT(oneSided(x, y).x, 0.02f * x - 0.002f) << x;  // biased low
             }
         }
+}
+
+TEST(MaafFilter, KernelStaysSymmetricAcrossABorderOfComponents) {
+    // Issue 28: where pixels with outer components (K = 5) meet pixels with the central one only
+    // (K = 1), a neighbour without component c must not leave its mirror image's component c in
+    // the window, or the modulated kernel turns one-sided there. Every pixel takes the same
+    // samples in +-pairs (so the sine bands vanish and a symmetric kernel reproduces a linear
+    // signal exactly); the border runs across image x (pass 1 of eq. 21) and across image y
+    // (pass 2). A constant signal must stay constant and a ramp must stay the ramp.
+    for (int axis = 0; axis < 2; ++axis) {
+        const int W = axis == 0 ? 40 : 6, H = axis == 0 ? 6 : 40, border = 20;
+        Plane pl(W, H);
+        MaafPixel outer = uniformParams(3, false), central = uniformParams(3, false);
+        for (int k = 0; k < 2; ++k) {
+            for (int c = 0; c < 3; ++c) outer.axis[k].sy[c] = outer.axis[k].su[c] = 0;  // no windows
+            central.axis[k] = outer.axis[k];
+            central.axis[k].pairs = 1;
+        }
+        outer.axis[1 - axis].pairs = 1;  // outer components along the tested axis only
+        Image<MaafPixel> stored(W, H);
+        for (int y = 0; y < H; ++y)
+            for (int x = 0; x < W; ++x) stored(x, y) = (axis == 0 ? x : y) < border ? outer : central;
+        MaafEffect params(stored);
+        MaafOptions o;
+        o.pairs = 3;
+        for (bool ramp : {false, true}) {
+            auto signal = [&](int x, int y) { return ramp ? 0.2f + 0.03f * float(axis == 0 ? x : y) : 0.6f; };
+            MaafAccumulator acc(params, 3, 1);
+            for (int y = 0; y < H; ++y)
+                for (int x = 0; x < W; ++x) {
+                    const size_t p = size_t(y) * W + x;
+                    const float v = signal(x, y);
+                    for (int s = 0; s < 6; ++s)
+                        for (float sign : {1.f, -1.f}) {
+                            const uint32_t k = uint32_t(s * 5);
+                            float yy[2] = {sign * (rnd(k) - 0.5f), sign * (rnd(k + 1) - 0.5f)};
+                            float u[2] = {sign * (rnd(k + 2) - 0.5f), sign * (rnd(k + 3) - 0.5f)};
+                            acc.add(p, &v, 1.f, yy, u, stored[p]);
+                        }
+                    acc.scale(p, 1.f / 12.f);
+                }
+            const Image3f out = acc.filter(params, pl.fb, pl.frames, Image3f(W, H, Vec3f(-1.f)), o);
+            const int radius = int(std::ceil(3.f / outer.axis[axis].sx[0]));
+            ASSERT_GE(radius, 4);
+            int checked = 0;
+            for (int i = radius; i < border; ++i) {  // pixels with outer components, the border within reach of many
+                const int x = axis == 0 ? i : W / 2, y = axis == 0 ? H / 2 : i;
+                EXPECT_NEAR(out(x, y).x, signal(x, y), 1e-4f) << "axis " << axis << (ramp ? " ramp" : " constant") << " at " << i;
+                ++checked;
+            }
+            EXPECT_GE(checked, 8);
+        }
+    }
 }
 
 TEST(MaafAccumulator, CentralOnlyPixelsFromTheirSumsEqualTheirSamples) {

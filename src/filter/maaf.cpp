@@ -60,6 +60,16 @@ double samplingSpectrum(const MaafComponent& c, const AxisInputs& in) {
     return in.lens ? mu * discSpectrum(c.cu) : mu;
 }
 
+}  // namespace
+
+int maafFitPairs(double omegaX, double step, const MaafOptions& o) {
+    const double fitRadius = double(o.fitShare) * o.maxRadius;
+    const int kFit = int(std::floor(o.spatialScale * omegaX * fitRadius * step / 3.0 + 1e-6));
+    return std::max(1, (kFit + 1) / 2);
+}
+
+namespace {
+
 MaafAxis buildAxis(const AxisInputs& in, const MaafOptions& o) {
     const int pairs = o.pairs, maxRadius = o.maxRadius;
     MaafAxis ax{};
@@ -96,12 +106,11 @@ MaafAxis buildAxis(const AxisInputs& in, const MaafOptions& o) {
     w.suMax = suHi;
     w.omegaUMax = in.omegaU;
     int n = (in.fallback || straddle) ? 1 : pairs;
-    // The window (maxRadius pixels) resolves Fourier widths down to about 3 / (maxRadius step):
-    // use only as many components as keep the central one that wide (K <= Omega_x R step / 3).
-    if (o.fitComponents) {
-        int kFit = int(std::floor(omegaX * maxRadius * in.step / 3.0));
-        n = std::max(1, std::min(n, (kFit + 1) / 2));
-    }
+    // The window resolves Fourier widths down to about 3 / (R step): use only as many components
+    // as keep the central one's 3 sigma within R = fitShare maxRadius pixels. Its Fourier std is
+    // spatialScale Omega_x / K (maafComponents: sx = (Om / s_min) / K = Omega_x / K), so
+    // 3 K / (spatialScale Omega_x step) <= R, K <= spatialScale Omega_x R step / 3.
+    if (o.fitComponents) n = std::min(n, maafFitPairs(omegaX, in.step, o));
     MaafComponent comps[kMaafMaxPairs];
     maafComponents(n, w, comps);
     ax.pairs = n;
@@ -446,19 +455,27 @@ Image3f MaafAccumulator::filter(const MaafEffect& params, const FrameBuffers& fb
             const int radius = win.radius;
             for (int k = -radius; k <= radius; ++k) {
                 if (!win.ok[k + radius]) continue;
-                // Outer components only where the mirror neighbour exists too: a one-sided window
-                // (an occluder's silhouette next to its shadow) would turn their modulation into bias.
-                bool mirror = !o.symmetricOuter || win.ok[radius - k];
                 size_t q = size_t(y) * W + x + k;
                 float a = win.a[k + radius], r = win.r[k + radius];
                 const float* T = pixel(q);
-                const int nq = (m_bands1[q] + 1) / 2, bq2 = m_bands2[q];  // the neighbour's own bands
-                for (int c = 0; c < (mirror ? ax.pairs : 1); ++c) {
-                    if (c >= nq) break;  // the neighbour accumulated no such component
+                const int bq2 = m_bands2[q];  // the neighbour's own bands: its storage's layout
+                // Outer components (of either axis) only where the mirror neighbour is accepted
+                // and has them too: a one-sided window (an occluder's silhouette next to its
+                // shadow, the border between pixels with and without outer components) would
+                // turn their modulation into bias (issue 28: a ramp across a K = 1 / K = 5
+                // border moved by 0.16%, filter_test KernelStaysSymmetricAcrossABorderOfComponents).
+                int pairs = std::min<int>(ax.pairs, (m_bands1[q] + 1) / 2), bands2 = bq2;
+                if (o.symmetricOuter) {
+                    const size_t m = size_t(y) * W + x - k;
+                    const bool mirror = win.ok[radius - k];
+                    pairs = mirror ? std::min<int>(pairs, (m_bands1[m] + 1) / 2) : 1;
+                    bands2 = mirror ? std::min<int>(bq2, m_bands2[m]) : 1;
+                }
+                for (int c = 0; c < pairs; ++c) {
                     float sr = ax.sx[c] * r;
                     float g = ax.weight[c] * ax.sx[c] * kInvSqrt2Pi * std::exp(-0.5f * sr * sr);
                     if (c == 0) {
-                        for (int j = 0; j < bq2 * C; ++j) out[j] += g * T[j];
+                        for (int j = 0; j < bands2 * C; ++j) out[j] += g * T[j];
                         for (int j = 0; j < C; ++j) out[B * C + j] += g * T[j];
                     } else {
                         float sn, cs;
@@ -466,7 +483,7 @@ Image3f MaafAccumulator::filter(const MaafEffect& params, const FrameBuffers& fb
                         float gc = g * cs, gs = g * sn;
                         const float* Tc = T + (2 * c - 1) * bq2 * C;
                         const float* Ts = T + (2 * c) * bq2 * C;
-                        for (int j = 0; j < bq2 * C; ++j) out[j] += gc * Tc[j] + gs * Ts[j];
+                        for (int j = 0; j < bands2 * C; ++j) out[j] += gc * Tc[j] + gs * Ts[j];
                     }
                 }
             }
@@ -489,12 +506,19 @@ Image3f MaafAccumulator::filter(const MaafEffect& params, const FrameBuffers& fb
             const int radius = win.radius;
             for (int k = -radius; k <= radius; ++k) {
                 if (!win.ok[k + radius]) continue;
-                bool mirror = !o.symmetricOuter || win.ok[radius - k];
                 size_t q = size_t(y + k) * W + x;
                 float a = win.a[k + radius], r = win.r[k + radius];
                 const float* I = &inter[interOffset[q]];
                 const int B = interBands[q];  // bands beyond B are zero
-                for (int c = 0; c < (mirror ? ax.pairs : 1) && 2 * c < B; ++c) {
+                // As in pass 1: components the mirror row has too.
+                int bands = B;
+                int pairs = ax.pairs;
+                if (o.symmetricOuter) {
+                    const bool mirror = win.ok[radius - k];
+                    pairs = mirror ? pairs : 1;
+                    if (mirror) bands = std::min<int>(B, interBands[size_t(y - k) * W + x]);
+                }
+                for (int c = 0; c < pairs && 2 * c < bands; ++c) {
                     float sr = ax.sx[c] * r;
                     float g = ax.weight[c] * ax.sx[c] * kInvSqrt2Pi * std::exp(-0.5f * sr * sr);
                     if (c == 0) {

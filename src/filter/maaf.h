@@ -132,10 +132,21 @@ struct MaafOptions {
     float pixelBandwidth = 2.449490f;  // Omega_x never exceeds this / (world size of a pixel)
     bool apertureWindows = false;    // eq. 20's Gaussian windows over the light and the lens
     MaafWeights weights = MaafWeights::Sampling;  // mu_p
-    bool fitComponents = true;       // use only as many components as the window resolves
+    bool fitComponents = true;       // use only as many components as the window resolves:
+    /// the fit keeps the central component's 3 sigma (its actual width, spatialScale included)
+    /// within this share of the window (maxRadius). 1 / sqrt(6) (4.1 px of the 10-px window) is
+    /// the rule as first written, which left spatialScale out; the whole window (1) measured worse
+    /// (docs/maaf.md, "The fit rule").
+    float fitShare = 0.40824829f;
     bool symmetricOuter = true;      // outer components only where a neighbour's mirror is accepted too
     bool mirrorSurfaceCuts = true;   // as AafOptions::mirrorSurfaceCuts, for every component
 };
+
+/// The most pairs N whose central component (K = 2N - 1, Fourier std spatialScale Omega_x / K
+/// along an axis of `step` world units per pixel) keeps its 3 sigma within o.fitShare x
+/// o.maxRadius pixels;
+/// at least 1. (The pairs used are also at most o.pairs.)
+int maafFitPairs(double omegaX, double step, const MaafOptions& o);
 
 /// One effect's components for every pixel, computed on demand: a MaafPixel is 232 bytes, and
 /// storing one per pixel and effect cost a 720x720 render 240 MB of freshly zeroed pages (7% of
