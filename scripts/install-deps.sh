@@ -10,6 +10,7 @@ packages=(
   chromium
   python3-dev pybind11-dev python3-numpy python3-pytest python3-matplotlib
   clang libclang-rt-14-dev llvm
+  libopenmpi-dev openmpi-bin
 )
 # chromium: the headless browser the experiment-report test screenshots (tests/experiment_test.cpp).
 # python3-dev, pybind11-dev: the Python module (python/); numpy for its arrays; pytest runs its
@@ -17,6 +18,8 @@ packages=(
 # clang, libclang-rt-14-dev (its sanitizer and libFuzzer runtimes; only recommended by clang, and
 # recommends are not installed here) and llvm (llvm-symbolizer, for the sanitizers' stack
 # traces): `make test-sanitize` and `make fuzz`.
+# libopenmpi-dev, openmpi-bin: Open MPI, so that the same binary runs under `mpirun -n N`
+# (docs/mpi.md); without mpirun it is one process as before.
 # Optional extras: `WEDGE_EXTRAS=1` adds Embree's path tracer used as the throughput peer in bench/.
 if [[ "${WEDGE_EXTRAS:-0}" == 1 ]]; then
   packages+=(embree-tools)
