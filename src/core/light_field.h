@@ -102,6 +102,7 @@ public:
     int width() const { return m_width; }
     int height() const { return m_height; }
     bool empty() const { return m_stages.empty(); }
+    int stages() const { return int(m_stages.size()); }
 
     /// Adds a stage with count(p) samples for pixel p (row-major index); returns its index.
     /// Throws wedge::Error (naming --layers) before allocating when the samples kept so far and

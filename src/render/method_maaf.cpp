@@ -218,6 +218,7 @@ void renderMaaf(const MethodContext& ctx, RenderResult& result) {
     t.reset();
     std::atomic<uint64_t> retracedRays{0};
     if (retrace) parallelRows(H, [&](int y) {
+        if (!ctx.sampler.tracesRow(y)) return;  // over several ranks, each its own rows
         uint64_t rays = 0;
         TracedSample batch[16];
         for (int x = 0; x < W; ++x) {
@@ -235,6 +236,12 @@ void renderMaaf(const MethodContext& ctx, RenderResult& result) {
         retracedRays += rays;
     });
     result.rays += retracedRays;
+    // Over several ranks (render/distribution.h), the records of the other ranks' rows.
+    if (!retrace) exchangeImageRows(ctx.sampler.distribution(), initial.data(), W, H, n0);
+    exchangeRows(ctx.sampler.distribution(), H, [&](int y) {
+        return std::pair<char*, size_t>{reinterpret_cast<char*>(records.data() + offset[size_t(y) * W]),
+                                        (offset[size_t(y + 1) * W] - offset[size_t(y) * W]) * sizeof(filter::MaafSample)};
+    });
     if (retrace) result.seconds.add("sampling_retrace", t.seconds());
     result.seconds.add("sampling", result.seconds.get("sampling_initial") + result.seconds.get("sampling_adaptive") +
                                        result.seconds.get("sampling_retrace"));

@@ -1,7 +1,9 @@
 #include "render/output.h"
 
+#include <algorithm>
 #include <cstdio>
 #include <sstream>
+#include <vector>
 
 #include "io/image_io.h"
 
@@ -57,6 +59,9 @@ nlohmann::json statsJson(const RenderResult& r, const std::string& sceneName) {
     j["spp_average"] = r.sppAverage;
     j["rays"] = r.rays;
     j["threads"] = r.threads;
+    // Over several MPI ranks (docs/mpi.md): the rays each traced; they sum to `rays`.
+    j["ranks"] = std::max<size_t>(1, r.raysPerRank.size());
+    j["rays_per_rank"] = r.raysPerRank.empty() ? std::vector<uint64_t>{r.rays} : r.raysPerRank;
     nlohmann::json sec = nlohmann::json::object();
     for (auto& [stage, s] : r.seconds.stages()) sec[stage] = s;
     j["seconds"] = sec;

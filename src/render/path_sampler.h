@@ -17,6 +17,8 @@
 
 namespace wedge::render {
 
+class Distribution;
+
 /// Everything one path sample produced: the record the filters see, plus the per-sample facts
 /// the pixel statistics (slopes, G-buffer) are built from.
 struct TracedSample {
@@ -66,6 +68,17 @@ public:
 
     const Camera& camera() const { return m_camera; }
     uint32_t seed() const { return m_seed; }
+    /// Over several ranks (render/distribution.h): this rank traces only its own rows, and the
+    /// sampling stages copy what they computed to every rank. Null: one process, every row.
+    void distribute(const Distribution* d, int rank, int ranks) {
+        m_distribution = d;
+        m_rank = rank;
+        m_ranks = ranks;
+    }
+    const Distribution* distribution() const { return m_distribution; }
+    int ranks() const { return m_ranks; }
+    /// Whether this rank traces row y (render/distribution.h, ownsRow).
+    bool tracesRow(int y) const { return m_ranks <= 1 || y % m_ranks == m_rank; }
     const scene::Scene& scene() const { return m_scene; }
     ViewGeometry view() const;
     /// The lights' closed-form irradiance at x (normal n), without occlusion
@@ -103,6 +116,8 @@ private:
     std::vector<Vec3f> m_groupCenter;  // each group's centroid
     std::vector<float> m_groupArea;
     scene::LightIrradiance m_irradiance;
+    const Distribution* m_distribution = nullptr;
+    int m_rank = 0, m_ranks = 1;
 };
 
 }  // namespace wedge::render

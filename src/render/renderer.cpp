@@ -7,6 +7,7 @@
 #include "core/parallel.h"
 #include "filter/defocus.h"
 #include "filter/layers.h"
+#include "render/distribution.h"
 #include "render/methods.h"
 #include "render/sampling.h"
 
@@ -54,6 +55,7 @@ Image<uint32_t> emitterTopUps(const PixelStatsImage& stats, uint32_t target) {
 uint64_t denseEmission(const MethodContext& ctx, const Image<uint32_t>& topUp, FrameBuffers& fb) {
     std::atomic<uint64_t> rays{0};
     parallelRows(fb.height, [&](int y) {
+        if (!ctx.sampler.tracesRow(y)) return;
         uint64_t local = 0;
         for (int x = 0; x < fb.width; ++x) {
             const size_t p = size_t(y) * fb.width + x;
@@ -65,6 +67,8 @@ uint64_t denseEmission(const MethodContext& ctx, const Image<uint32_t>& topUp, F
         }
         rays += local;
     });
+    exchangeImageRows(ctx.sampler.distribution(), fb.color.data(), fb.width, fb.height);
+    exchangeImageRows(ctx.sampler.distribution(), fb.emission.data(), fb.width, fb.height);
     return rays;
 }
 
@@ -77,6 +81,7 @@ Image3f visibilityImage(const FrameBuffers& fb) {
 void finishLightField(const MethodContext& ctx, const PixelStatsImage& stats) {
     if (!ctx.lightField) return;
     LightFieldSamples& lf = *ctx.lightField;
+    exchangeLightField(ctx.sampler.distribution(), lf);  // each rank recorded its own rows' samples
     parallelRows(lf.height(), [&](int y) {
         for (int x = 0; x < lf.width(); ++x) {
             const size_t p = size_t(y) * lf.width() + x;
@@ -173,6 +178,7 @@ RenderResult render(const scene::Scene& scene, const RenderOptions& options) {
     Timer total;
     Camera camera(desc.camera);
     PathSampler sampler(scene, camera, desc.render.indirect, seed);
+    if (const Distribution* d = options.distribution; d && d->ranks() > 1) sampler.distribute(d, d->rank(), d->ranks());
     // The light field is kept where reconstructing across pixels can change anything: a lens or
     // motion (without either, every layer is sharp and the result is each pixel's own samples).
     LightFieldSamples lightField;
@@ -191,6 +197,10 @@ RenderResult render(const scene::Scene& scene, const RenderOptions& options) {
     else if (options.method == "maaf") renderMaaf(ctx, result);
     else renderAtrous(ctx, result);
     result.sppAverage = averageSpp(result.buffers);
+    // Each rank counted the rays it traced.
+    result.raysPerRank = gatherCounts(sampler.distribution(), result.rays);
+    result.rays = 0;
+    for (uint64_t r : result.raysPerRank) result.rays += r;
     result.seconds.add("total", total.seconds());
     return result;
 }

@@ -14,6 +14,8 @@
 
 namespace wedge::render {
 
+class Distribution;
+
 struct RenderOptions {
     std::string method = "mc";
     std::optional<int> spp;          // mc: samples per pixel; aaf/maaf: initial samples per pixel
@@ -48,6 +50,10 @@ struct RenderOptions {
     // better of the two per method: on for mc and atrous up to kLayersAutoSpp samples per pixel,
     // off for aaf and maaf (docs/layers.md).
     std::string layers = "auto";
+    /// Several ranks rendering one image together (render/distribution.h; the command line's
+    /// MPI ranks): every rank calls render() with the same options and gets the same result.
+    /// Null: one process.
+    const Distribution* distribution = nullptr;
     /// `auto` reconstructs with layers up to this many samples per pixel: where it was measured
     /// (16-64), and where the samples it keeps (24 bytes each) fit: a 4096-spp reference at
     /// 512x512 would keep 26 GB and take the stage minutes for what plain Monte Carlo already has.
@@ -64,7 +70,8 @@ struct RenderResult {
     FrameBuffers buffers;
     StageTimes seconds;  // per stage, "total" added at the end
     double sppAverage = 0;
-    uint64_t rays = 0;
+    uint64_t rays = 0;  // over every rank
+    std::vector<uint64_t> raysPerRank;  // the rays each rank traced ({rays} in one process)
     int threads = 0;
     std::vector<std::pair<std::string, double>> extra;  // method-specific figures for --stats
     /// The method-specific figure `key`, if the method gave it.

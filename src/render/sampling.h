@@ -11,6 +11,7 @@
 #include "core/light_field.h"
 #include "core/parallel.h"
 #include "core/progress.h"
+#include "render/distribution.h"
 #include "render/pixel_stats.h"
 
 namespace wedge::render {
@@ -47,7 +48,9 @@ private:
 };
 
 /// range(x, y) -> SampleRange; sink(x, y, const TracedSample&, int slot) with the surface slot
-/// PixelStats::add put the sample in. Returns the number of rays traced.
+/// PixelStats::add put the sample in. Returns the number of rays traced. Over several ranks
+/// (render/distribution.h) only this rank's rows are traced, and then every pixel's statistics
+/// are copied from its owner, so that every rank holds all of them, as one process would.
 template <class RangeFn, class SinkFn>
 uint64_t samplePixels(const PathSampler& sampler, PixelStatsImage& stats, const ViewGeometry& view, RangeFn&& range,
                       bool span, bool slopes, SinkFn&& sink, Progress* progress) {
@@ -55,7 +58,8 @@ uint64_t samplePixels(const PathSampler& sampler, PixelStatsImage& stats, const 
     SlotPool& pool = stats.pool();
     parallelTiles(stats.width(), stats.height(), 16, [&](int x0, int x1, int y0, int y1) {
         uint64_t localRays = 0, localSamples = 0;
-        for (int y = y0; y < y1; ++y)
+        for (int y = y0; y < y1; ++y) {
+            if (!sampler.tracesRow(y)) continue;
             for (int x = x0; x < x1; ++x) {
                 SampleRange r = range(x, y);
                 PixelStats& ps = stats(x, y);
@@ -71,9 +75,11 @@ uint64_t samplePixels(const PathSampler& sampler, PixelStatsImage& stats, const 
                 }
                 localSamples += r.count;
             }
+        }
         rays += localRays;
-        if (progress) progress->add(localSamples);
+        if (progress) progress->add(localSamples * uint64_t(sampler.ranks()));  // rank 0's share, scaled
     });
+    exchangeStats(sampler.distribution(), stats);
     return rays;
 }
 
