@@ -4,6 +4,7 @@
 
 #include "apps/wedge/commands.h"
 #include "apps/wedge/common.h"
+#include "apps/wedge/mpi_session.h"
 #include "apps/wedge/render_flags.h"
 #include "core/error.h"
 #include "core/memory_limit.h"
@@ -42,17 +43,28 @@ void checkRenderMemory(const scene::SceneDesc& desc, const render::RenderOptions
 }
 
 void runRender(const RenderArgs& a) {
-    const render::RenderOptions opt = a.flags.renderOptions();
+    // Under mpirun every rank renders its share (docs/mpi.md); rank 0 alone speaks and writes.
+    const MpiSession& mpi = MpiSession::get();
+    const bool root = mpi.rank() == 0;
+    render::RenderOptions opt = a.flags.renderOptions();
+    opt.distribution = mpi.distribution();
+    if (!root) {
+        opt.quiet = true;
+        opt.aovDir.clear();
+    }
     for (const auto& o : a.outputs) io::checkOutputPath(o, render::outputExtensions());
     if (!a.stats.empty()) io::checkOutputPath(a.stats, {".json"});
 
     ThreadLimit limit(a.flags.threads);
     scene::SceneDesc desc = scene::loadScene(a.scene);
-    printWarnings(desc);
+    if (root) printWarnings(desc);
     a.flags.applyTo(desc);
     checkRenderMemory(desc, opt);
     scene::Scene scene(std::move(desc));
+    const uint64_t bytesBefore = mpi.bytesExchanged();
     render::RenderResult result = render::render(scene, opt);
+    if (mpi.active()) result.extra.emplace_back("mpi_bytes_exchanged", double(mpi.bytesExchanged() - bytesBefore));
+    if (!root) return;
     if (const size_t bad = render::nonFinitePixels(result); bad > 0)
         std::fprintf(stderr, "wedge: warning: %zu pixels have non-finite (NaN or infinite) samples or colour\n", bad);
 
