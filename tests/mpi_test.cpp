@@ -1,7 +1,7 @@
 // `mpirun -n N wedge render` (docs/mpi.md): the same files as one process, bit for bit, for every
 // method, at a resolution whose rows do not divide among the ranks; --stats' ranks and rays per
-// rank; bad input under MPI (one message, exit 2 on every rank, nothing written); a rank that
-// fails or hangs ends the job instead of hanging it. Skipped when wedge was built without MPI.
+// rank; `experiment`'s results; bad input under MPI (one message, exit 2 on every rank, nothing
+// written); a rank that fails or hangs ends the job instead of hanging it. Skipped when wedge was built without MPI.
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 #include <sys/wait.h>
@@ -169,6 +169,37 @@ TEST(Mpi, OneRankUnderMpirunIsOneProcess) {
         << err;
     EXPECT_TRUE(readFile(dir + "/a.exr") == readFile(dir + "/b.exr"));
     EXPECT_EQ(readJson(dir + "/b.json")["ranks"], 1);
+}
+
+/// results.json without what depends on the clock (stage times, efficiencies, overheads).
+nlohmann::json withoutTimes(nlohmann::json j) {
+    if (j.is_object()) {
+        nlohmann::json out = nlohmann::json::object();
+        for (auto& [k, v] : j.items())
+            if (k != "seconds" && k.find("efficiency") == std::string::npos && k != "overhead") out[k] = withoutTimes(v);
+        return out;
+    }
+    if (j.is_array())
+        for (auto& v : j) v = withoutTimes(v);
+    return j;
+}
+
+TEST(Mpi, ExperimentResultsAreTheOneProcessesApartFromTimes) {
+    REQUIRE_MPI();
+    // Its renders (the reference's halves, the methods, the variance renders, an equal-quality
+    // search) split over the ranks; only rank 0 writes.
+    const std::string dir = tempDir();
+    const std::string args = "experiment cornell --methods mc,aaf --spp 2 --reference-spp 16 --resolution 32x24 --equal-quality --quiet --out ";
+    std::string err;
+    ASSERT_EQ(runRanks(0, args + dir + "/one", &err), 0) << err;
+    ASSERT_EQ(runRanks(3, args + dir + "/three", &err), 0) << err;
+    const nlohmann::json one = readJson(dir + "/one/results.json"), three = readJson(dir + "/three/results.json");
+    ASSERT_FALSE(one.empty());
+    EXPECT_EQ(withoutTimes(one), withoutTimes(three));
+    EXPECT_TRUE(fs::exists(dir + "/three/index.html"));
+    // The second run of each takes the reference from its cache, on every rank alike.
+    ASSERT_EQ(runRanks(2, args + dir + "/three", &err), 0) << err;
+    EXPECT_EQ(withoutTimes(readJson(dir + "/three/results.json")), withoutTimes(one));
 }
 
 TEST(Mpi, OtherCommandsRunOnRankZeroAlone) {

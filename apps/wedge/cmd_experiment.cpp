@@ -8,6 +8,7 @@
 
 #include "apps/wedge/commands.h"
 #include "apps/wedge/common.h"
+#include "apps/wedge/mpi_session.h"
 #include "apps/wedge/render_flags.h"
 #include "core/error.h"
 #include "core/parallel.h"
@@ -56,9 +57,18 @@ void runExperiment(ExperimentArgs& a) {
     if (a.seed >= 0) o.seed = uint32_t(a.seed);
     render::checkExperimentOptions(o);
 
+    // Under mpirun every rank runs the experiment and each render is split over them
+    // (docs/mpi.md); rank 0 alone prints and writes.
+    const MpiSession& mpi = MpiSession::get();
+    o.base.distribution = mpi.distribution();
+    if (mpi.rank() != 0) {
+        o.quiet = true;
+        o.writes = false;
+    }
+
     ThreadLimit limit(a.threads);
     scene::SceneDesc desc = scene::loadScene(o.sceneName);
-    printWarnings(desc);
+    if (mpi.rank() == 0) printWarnings(desc);
     applyResolution(desc, a.resolution);
     scene::Scene scene(std::move(desc));
     render::runExperiment(scene, o);

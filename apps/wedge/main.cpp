@@ -62,11 +62,11 @@ int main(int argc, char** argv) {
     wedge::app::registerExperiment(app);
     wedge::app::registerAnalyze(app);
     wedge::app::registerRaster(app);
-    // Under mpirun, `render` runs on every rank together; the other commands on rank 0 alone
-    // (docs/mpi.md), while the other ranks wait for its exit code.
+    // Under mpirun, `render` and `experiment` run on every rank together; the other commands on
+    // rank 0 alone (docs/mpi.md), while the other ranks wait for its exit code.
     if (mpi.active() && mpi.rank() != 0)
         for (CLI::App* sub : app.get_subcommands([](CLI::App*) { return true; }))
-            if (sub->get_name() != "render") sub->callback([] {});
+            if (sub->get_name() != "render" && sub->get_name() != "experiment") sub->callback([] {});
 
     std::string message;
     bool agreed = false;

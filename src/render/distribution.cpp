@@ -3,6 +3,7 @@
 #include <type_traits>
 
 #include "core/light_field.h"
+#include "core/timer.h"
 #include "render/pixel_stats.h"
 
 namespace wedge::render {
@@ -69,6 +70,24 @@ std::vector<uint64_t> gatherCounts(const Distribution* d, uint64_t mine) {
         out.push_back(v);
     }
     return out;
+}
+
+void shareRootTimes(const Distribution* d, StageTimes& times) {
+    if (!d || d->ranks() <= 1) return;
+    std::vector<double> mine;
+    for (const auto& [name, s] : times.stages()) mine.push_back(s);
+    std::vector<char> bytes(mine.size() * sizeof(double));
+    if (!mine.empty()) std::memcpy(bytes.data(), mine.data(), bytes.size());
+    const std::vector<char> root = d->allgather(bytes)[0];
+    if (root.size() != bytes.size()) throw std::length_error("shareRootTimes: rank 0 timed other stages");
+    StageTimes shared;
+    size_t k = 0;
+    for (const auto& [name, s] : times.stages()) {
+        double v = 0;
+        std::memcpy(&v, root.data() + k++ * sizeof(double), sizeof v);
+        shared.add(name, v);
+    }
+    times = shared;
 }
 
 }  // namespace wedge::render

@@ -21,6 +21,7 @@
 
 namespace wedge {
 class LightFieldSamples;
+class StageTimes;
 }
 
 namespace wedge::render {
@@ -85,5 +86,8 @@ void exchangeStats(const Distribution* d, PixelStatsImage& stats);
 void exchangeLightField(const Distribution* d, LightFieldSamples& lf);
 /// Every rank's `mine`, in rank order ({mine} without a distribution).
 std::vector<uint64_t> gatherCounts(const Distribution* d, uint64_t mine);
+/// Replaces every rank's stage times by rank 0's (the same stages everywhere), so that what is
+/// decided on times (wedge experiment's equal-time searches) is decided alike on every rank.
+void shareRootTimes(const Distribution* d, StageTimes& times);
 
 }  // namespace wedge::render

@@ -12,6 +12,7 @@
 #include "core/error.h"
 #include "core/parallel.h"
 #include "core/sampler.h"
+#include "render/distribution.h"
 #include "io/image_io.h"
 #include "io/plot.h"
 #include "io/output_file.h"
@@ -200,20 +201,28 @@ void Experiment::loadOrRenderReference() {
                   m_result.width, m_result.height, m_result.referenceSpp, m_result.referenceSeed, hash);
     fs::path exr = fs::path(m_options.cacheDir) / (std::string(key) + ".exr");
     fs::path meta = fs::path(m_options.cacheDir) / (std::string(key) + ".json");
+    bool cached = false;
     if (fs::is_regular_file(exr) && fs::is_regular_file(meta)) {
         try {
             m_reference = io::readColor(exr.string());
             nlohmann::json j = nlohmann::json::parse(io::readTextFile(meta.string()));
             m_result.referenceSeconds = j.at("seconds").get<double>();
             m_result.referenceNoise = j.at("noise_relmse").get<double>();  // older entries lack it: render again
-            if (m_reference.sameSize(m_result.width, m_result.height)) {
-                m_result.referenceCached = true;
-                say("reference from cache " + exr.string());
-                return;
-            }
+            cached = m_reference.sameSize(m_result.width, m_result.height);
         } catch (const std::exception&) {
             // A damaged or older cache entry is rendered again and overwritten.
         }
+    }
+    // Over MPI ranks, every rank must take the same way (the reference's renders are collective).
+    const std::vector<uint64_t> ranksCached = gatherCounts(m_options.base.distribution, cached ? 1 : 0);
+    for (size_t r = 1; r < ranksCached.size(); ++r)
+        if (ranksCached[r] != ranksCached[0])
+            throw Error("--cache " + m_options.cacheDir, "rank 0 and rank " + std::to_string(r) +
+                                                             " see different reference caches (give every rank the same cache directory)");
+    if (cached) {
+        m_result.referenceCached = true;
+        say("reference from cache " + exr.string());
+        return;
     }
     // Two independent halves (the second with its own seed): their difference measures the
     // reference's own noise.
@@ -228,6 +237,7 @@ void Experiment::loadOrRenderReference() {
     m_reference = metrics::combineHalves(a.color, nA, b.color, nB);
     m_result.referenceNoise = metrics::referenceNoise(a.color, nA, b.color, nB);
     m_result.referenceSeconds = a.seconds.get("total") + b.seconds.get("total");
+    if (!m_options.writes) return;
     fs::create_directories(m_options.cacheDir);
     io::writeColor(exr.string(), m_reference);
     nlohmann::json j;
@@ -339,7 +349,7 @@ ExperimentResult Experiment::run() {
     m_result.referenceSpp = m_options.referenceSpp;
     m_cap = m_options.maxSpp > 0 ? m_options.maxSpp : std::max(m_options.spp, m_options.referenceSpp / 4);
 
-    fs::create_directories(fs::path(m_options.outDir) / "images");
+    if (m_options.writes) fs::create_directories(fs::path(m_options.outDir) / "images");
     if (m_options.cacheDir.empty()) m_options.cacheDir = (fs::path(m_options.outDir) / "cache").string();
 
     // Warm-up: the first render of a process pays for starting the worker threads.
@@ -354,7 +364,7 @@ ExperimentResult Experiment::run() {
         const ExperimentProbe* p = evaluate(m, m_options.spp);
         if (!p) {
             m_result.skipped.push_back(m);
-            std::fprintf(stderr, "wedge: warning: experiment: method '%s' is not available yet; skipped\n", m.c_str());
+            if (m_options.writes) std::fprintf(stderr, "wedge: warning: experiment: method '%s' is not available yet; skipped\n", m.c_str());
             continue;
         }
         available.push_back(m);
@@ -416,6 +426,7 @@ ExperimentResult Experiment::run() {
         row.netEfficiency = net > 0 ? 1.0 / net : 0.0;
     }
 
+    if (!m_options.writes) return m_result;
     writeImages();
     writeResultsJson();
     std::string table = markdownTable();

@@ -48,6 +48,9 @@ struct ExperimentOptions {
     std::string anchor;                // default: maaf, else aaf, else atrous, else the first method
     bool equalTime = false, equalQuality = false;
     bool quiet = false;
+    // Over MPI ranks (base.distribution, docs/mpi.md) every rank runs the experiment, each render
+    // split over them; the others than rank 0 neither write files nor print (writes = false).
+    bool writes = true;
     int maxSpp = 0;                    // search cap; 0: referenceSpp / 4
     double tolerance = 0.1;            // searches stop when hi <= lo (1 + tolerance) or hi - lo <= 1
     int repeat = 1;                    // renders per probe; the fastest one's times count

@@ -202,6 +202,7 @@ RenderResult render(const scene::Scene& scene, const RenderOptions& options) {
     result.rays = 0;
     for (uint64_t r : result.raysPerRank) result.rays += r;
     result.seconds.add("total", total.seconds());
+    shareRootTimes(sampler.distribution(), result.seconds);  // every rank returns the same result
     return result;
 }
 

@@ -51,7 +51,8 @@ struct RenderOptions {
     // off for aaf and maaf (docs/layers.md).
     std::string layers = "auto";
     /// Several ranks rendering one image together (render/distribution.h; the command line's
-    /// MPI ranks): every rank calls render() with the same options and gets the same result.
+    /// MPI ranks): every rank calls render() with the same options and gets the same result
+    /// (rank 0's stage times, its own `threads`).
     /// Null: one process.
     const Distribution* distribution = nullptr;
     /// `auto` reconstructs with layers up to this many samples per pixel: where it was measured
