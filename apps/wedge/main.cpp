@@ -50,7 +50,7 @@ int main(int argc, char** argv) {
     try {
         mpi.init(&argc, &argv);
     } catch (const wedge::Error& e) {
-        std::fprintf(stderr, "wedge: error: %s\n", e.what());
+        if (mpi.rank() == 0) std::fprintf(stderr, "wedge: error: %s\n", e.what());  // once, not per copy
         return 2;
     }
     CLI::App app{"wedge: sparse sampling and Fourier-derived reconstruction filters for distribution effects"};

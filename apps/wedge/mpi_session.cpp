@@ -24,6 +24,13 @@ int launcherSize() {
     return 1;
 }
 
+/// This process's rank as the launcher numbered it (0 when not started by one).
+[[maybe_unused]] int launcherRank() {
+    for (const char* var : {"OMPI_COMM_WORLD_RANK", "PMI_RANK", "PMIX_RANK"})
+        if (const char* v = std::getenv(var)) return std::max(0, std::atoi(v));
+    return 0;
+}
+
 #ifdef WEDGE_HAVE_MPI
 void onMpiError(MPI_Comm* comm, int* code, ...) {
     char text[MPI_MAX_ERROR_STRING];
@@ -76,9 +83,11 @@ void MpiSession::init(int* argc, char*** argv) {
 #else
     (void)argc;
     (void)argv;
-    if (size > 1)
+    if (size > 1) {
+        m_rank = launcherRank();  // main reports the error on rank 0 alone
         throw Error("mpirun", "this wedge was built without MPI, and mpirun started " + std::to_string(size) +
                                   " copies of it (install libopenmpi-dev, e.g. with scripts/install-deps.sh, and rebuild)");
+    }
 #endif
 }
 
