@@ -12,11 +12,11 @@
 #include "core/error.h"
 #include "core/parallel.h"
 #include "core/sampler.h"
-#include "render/distribution.h"
 #include "io/image_io.h"
 #include "io/plot.h"
 #include "io/output_file.h"
 #include "io/text_file.h"
+#include "render/distribution.h"
 
 namespace fs = std::filesystem;
 
