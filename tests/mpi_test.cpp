@@ -159,6 +159,19 @@ TEST(Mpi, AHangingRankEndsTheJobAfterTheTimeout) {
     EXPECT_FALSE(fs::exists(dir + "/x.exr"));
 }
 
+TEST(Mpi, ARankThatDiesEndsTheJob) {
+    REQUIRE_MPI();
+    // Rank 1 is killed (SIGKILL) at its first exchange: mpirun ends the job and says which rank.
+    const std::string dir = tempDir();
+    std::string err;
+    const int rc = runRanks(2, "render cornell --spp 2 --resolution 32x24 --quiet -o " + dir + "/x.exr", &err,
+                            "WEDGE_MPI_FAULT=1:die");
+    EXPECT_NE(rc, 0) << err;
+    EXPECT_NE(rc, 124) << "timed out: the job hung\n" << err;
+    EXPECT_NE(err.find("rank 1"), std::string::npos) << err;
+    EXPECT_FALSE(fs::exists(dir + "/x.exr"));
+}
+
 TEST(Mpi, OneRankUnderMpirunIsOneProcess) {
     REQUIRE_MPI();
     const std::string dir = tempDir();

@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <climits>
+#include <csignal>
 #include <cstdio>
 #include <cstdlib>
 #include <stdexcept>
@@ -138,6 +139,7 @@ std::vector<std::vector<char>> MpiSession::allgather(const std::vector<char>& mi
     if (m_rank == m_faultRank) {
         if (m_fault == "hang")
             for (;;) std::this_thread::sleep_for(std::chrono::seconds(1));
+        if (m_fault == "die") std::raise(SIGKILL);
         throw std::runtime_error("injected failure (WEDGE_MPI_FAULT)");
     }
     // Every exchange starts with an agreement: a rank that failed meets it from main's last one.

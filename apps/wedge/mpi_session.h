@@ -62,8 +62,8 @@ private:
     int m_rank = 0, m_ranks = 1;
     bool m_joined = false;
     double m_timeout = 3600;
-    // Fault injection for the tests (tests/mpi_test.sh): WEDGE_MPI_FAULT=RANK:fail makes that
-    // rank throw at its first exchange, RANK:hang makes it sleep there.
+    // Fault injection for the tests (tests/mpi_test.cpp): WEDGE_MPI_FAULT=RANK:fail makes that
+    // rank throw at its first exchange, RANK:hang makes it sleep there, RANK:die kills it.
     int m_faultRank = -1;
     std::string m_fault;
     mutable uint64_t m_bytes = 0;
