@@ -280,6 +280,38 @@ TEST(ImageIo, ExrHeadersAreCheckedBeforeAllocating) {
     EXPECT_NE(missing.find("not a readable EXR file"), std::string::npos) << missing;
 }
 
+TEST(ImageIo, ExrAttributesAndDecodingBuffersAreCheckedBeforeOpenEXRAllocatesThem) {
+    std::string dir = test::tempDir();
+    // An attribute of a type OpenEXR does not know, declaring 2 GB in a 400-byte file: the C++
+    // library allocated the declared size before reading it (fuzz_exr spent its time there).
+    std::string opaque = "blob";
+    opaque += '\0';
+    opaque += "mystery";
+    opaque += '\0';
+    opaque += std::string("\xff\xff\xff\x7f", 4);  // 2^31 - 1 bytes
+    opaque += "abcd";
+    test::writeFile(dir + "/opaque.exr", test::exrHeader(0, 0, 7, 7, 1, 8, 0, opaque));
+    const std::string big = readError(dir + "/opaque.exr");
+    EXPECT_NE(big.find(dir + "/opaque.exr: not a readable EXR file: "), std::string::npos) << big;
+    EXPECT_NE(big.find("blob"), std::string::npos) << "names the attribute: " << big;
+    // A header whose floats fit (16384 x 1 x 99 channels: 6.2 MiB) but whose compression (DWAB:
+    // blocks of 256 lines) has OpenEXR size each decoding buffer for 256 lines of it.
+    test::writeFile(dir + "/dwab.exr", test::exrHeader(0, 0, 16383, 0, 99, 1, 9));
+    setMemoryLimit(uint64_t(1) << 30);
+    const std::string wide = readError(dir + "/dwab.exr");
+    setMemoryLimit(0);
+    EXPECT_NE(wide.find(dir + "/dwab.exr: the EXR's floats and OpenEXR's "), std::string::npos) << wide;
+    EXPECT_NE(wide.find("decoding buffers for its blocks of 256 lines (16384 pixels wide, 396 bytes a pixel) needs "),
+              std::string::npos)
+        << wide;
+    EXPECT_NE(wide.find("more than the memory limit of 1.0 GiB (--max-memory)"), std::string::npos) << wide;
+    // A deep file is refused for what it is (version flag 0x800: non-image parts).
+    std::string deep = test::exrHeader(0, 0, 7, 7, 1, 8);
+    deep[5] = 0x08;
+    test::writeFile(dir + "/deep-data.exr", deep);
+    EXPECT_NE(readError(dir + "/deep-data.exr").find(dir + "/deep-data.exr: "), std::string::npos);
+}
+
 TEST(ImageIo, PathsTheFileSystemRefusesAreErrorsNotExceptions) {
     // A name over NAME_MAX made std::filesystem::is_regular_file throw past wedge's errors
     // (fuzz_obj: a 4 KB map_Kd name; the CLI said "internal error" and exited 1).

@@ -90,7 +90,8 @@ void writeJpeg(const std::string& path, int w, int h, int components, const std:
     std::fclose(fp);
 }
 
-std::string exrHeader(int x0, int y0, int x1, int y1, int channels, size_t offsets) {
+std::string exrHeader(int x0, int y0, int x1, int y1, int channels, size_t offsets, int compression,
+                      const std::string& extra) {
     std::string b;
     auto i32 = [&](uint32_t v) {
         for (int k = 0; k < 4; ++k) b += char(v >> (8 * k));
@@ -117,7 +118,7 @@ std::string exrHeader(int x0, int y0, int x1, int y1, int channels, size_t offse
     }
     b += '\0';
     attribute("compression", "compression", 1);
-    b += '\0';  // none
+    b += char(compression);
     attribute("dataWindow", "box2i", 16);
     box(x0, y0, x1, y1);
     attribute("displayWindow", "box2i", 16);
@@ -131,6 +132,7 @@ std::string exrHeader(int x0, int y0, int x1, int y1, int channels, size_t offse
     i32(0);
     attribute("screenWindowWidth", "float", 4);
     i32(0x3f800000);
+    b += extra;
     b += '\0';  // end of the header
     for (size_t k = 0; k < offsets; ++k) b += std::string("\xff\xff\xff\x00\x00\x00\x00\x00", 8);
     return b;

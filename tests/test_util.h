@@ -34,8 +34,10 @@ int runWedge(const std::string& args, std::string* out = nullptr, std::string* e
 /// The bytes of a scan-line EXR header over the data window (x0, y0)-(x1, y1) with `channels`
 /// FLOAT channels, no compression, then `offsets` line offsets that point past the end of the
 /// file (the layout of OpenEXR's "OpenEXR File Layout"): a header that asks for what it likes
-/// with almost no file behind it.
-std::string exrHeader(int x0, int y0, int x1, int y1, int channels, size_t offsets);
+/// with almost no file behind it. `compression` is the header's compression byte (0 none, 9
+/// DWAB); `extra` is appended to the header's attributes as it is (name, type, size, value).
+std::string exrHeader(int x0, int y0, int x1, int y1, int channels, size_t offsets, int compression = 0,
+                      const std::string& extra = "");
 /// The repository's source directory.
 std::string sourceDir();
 

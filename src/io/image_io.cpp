@@ -7,6 +7,7 @@
 #include <OpenEXR/ImfOutputFile.h>
 #include <OpenEXR/ImfStdIO.h>
 #include <OpenEXR/ImfThreading.h>
+#include <OpenEXR/openexr.h>
 #include <png.h>
 #include <cstdio>  // before jpeglib.h, which needs FILE and size_t declared
 #include <jpeglib.h>
@@ -18,6 +19,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <memory>
 #include <mutex>
 #include <sstream>
 #include <thread>
@@ -129,6 +131,93 @@ void writeExr(const std::string& path, int width, int height, const std::vector<
     });
 }
 
+namespace {
+
+/// The first error OpenEXRCore reports while it reads a header (its user data: a std::string).
+void keepExrCoreError(exr_const_context_t ctxt, exr_result_t code, const char* message) {
+    void* user = nullptr;
+    if (exr_get_user_data(ctxt, &user) != EXR_ERR_SUCCESS || !user) return;
+    auto& kept = *static_cast<std::string*>(user);
+    if (kept.empty()) kept = message && *message ? message : exr_get_default_error_message(code);
+}
+
+/// Bytes of a pixel type as the file stores it.
+uint64_t exrTypeBytes(exr_pixel_type_t t) { return t == EXR_PIXEL_HALF ? 2 : 4; }
+
+/// Reads the header of `path` alone with OpenEXRCore (the C core of the library), which checks
+/// every attribute's declared size against the file's size and the data window and tiles against
+/// the largest wedge reads, and refuses what the C++ library would allocate past the memory limit
+/// as it opens the file: it reads an attribute by allocating the size the header declares (2 GB
+/// from a few bytes: what held fuzz_exr to 30 executions a second), and sizes its decoding buffers
+/// from the header (one per thread and one more, each a chunk of lines or a tile, and about three
+/// times that again in the decompressor's scratch) before reading a pixel.
+void checkExrHeader(const std::string& path, int threads) {
+    std::string why;
+    exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
+    init.error_handler_fn = keepExrCoreError;
+    init.user_data = &why;
+    init.max_image_width = init.max_image_height = kMaxImageSide;
+    init.max_tile_width = init.max_tile_height = kMaxImageSide;
+    exr_context_t ctxt = nullptr;
+    const exr_result_t opened = exr_start_read(&ctxt, path.c_str(), &init);
+    // Closes the context on every way out.
+    std::unique_ptr<exr_context_t, void (*)(exr_context_t*)> closer(&ctxt, [](exr_context_t* c) {
+        if (*c) exr_finish(c);
+    });
+    // An error it reports is a refusal even where it goes on: OpenEXRCore 3.1 reports an
+    // attribute larger than the file, skips it and returns success.
+    if (opened != EXR_ERR_SUCCESS || !why.empty()) {
+        if (why.empty()) why = exr_get_default_error_message(opened);
+        throw Error(path, "not a readable EXR file: " + why);
+    }
+    exr_storage_t storage = EXR_STORAGE_SCANLINE;
+    exr_attr_box2i_t dw{};
+    const exr_attr_chlist_t* channels = nullptr;
+    if (exr_get_storage(ctxt, 0, &storage) != EXR_ERR_SUCCESS || exr_get_data_window(ctxt, 0, &dw) != EXR_ERR_SUCCESS ||
+        exr_get_channels(ctxt, 0, &channels) != EXR_ERR_SUCCESS || !channels)
+        throw Error(path, "not a readable EXR file: " + (why.empty() ? std::string("incomplete header") : why));
+    if (storage == EXR_STORAGE_DEEP_SCANLINE || storage == EXR_STORAGE_DEEP_TILED)
+        throw Error(path, "a deep EXR (a list of samples per pixel) is not an image wedge reads");
+    // In 64 bits: a window from INT_MIN to INT_MAX is 2^32 pixels wide.
+    const int64_t w = int64_t(dw.max.x) - dw.min.x + 1, h = int64_t(dw.max.y) - dw.min.y + 1;
+    if (w <= 0 || h <= 0) throw Error(path, "the EXR's data window is empty");
+    if (const std::string big = oversize("EXR", uint64_t(w), uint64_t(h)); !big.empty()) throw Error(path, big);
+    uint64_t pixelBytes = 0;  // a pixel of every channel, as the file stores it
+    for (int c = 0; c < channels->num_channels; ++c) pixelBytes += exrTypeBytes(channels->entries[c].pixel_type);
+    // Every channel is read as w x h floats, allocated before any pixel is read.
+    const uint64_t count = uint64_t(channels->num_channels), floats = count * uint64_t(w) * uint64_t(h) * sizeof(float);
+    checkMemory(path, "the EXR's " + std::to_string(count) + " channels of " + std::to_string(w) + "x" + std::to_string(h) +
+                          " floats",
+                floats);
+    // OpenEXR's buffers: one chunk (a block of lines, or a tile) a buffer as the file stores it,
+    // and up to three times that in its decompressor (B44's scratch is twice the chunk); a tiled
+    // file read as lines also goes through a row of tiles in floats.
+    const uint64_t buffers = uint64_t(std::max(1, 2 * threads));
+    uint64_t chunkBytes = 0, tileRow = 0;
+    std::string chunk;
+    if (storage == EXR_STORAGE_TILED) {
+        uint32_t tw = 0, th = 0;
+        exr_tile_level_mode_t level{};
+        exr_tile_round_mode_t round{};
+        if (exr_get_tile_descriptor(ctxt, 0, &tw, &th, &level, &round) != EXR_ERR_SUCCESS)
+            throw Error(path, "not a readable EXR file: " + (why.empty() ? std::string("no tile description") : why));
+        chunkBytes = uint64_t(tw) * th * pixelBytes;
+        tileRow = uint64_t(w) * th * count * sizeof(float);
+        chunk = std::to_string(tw) + "x" + std::to_string(th) + " tiles";
+    } else {
+        int32_t lines = 1;
+        if (exr_get_scanlines_per_chunk(ctxt, 0, &lines) != EXR_ERR_SUCCESS || lines < 1) lines = 1;
+        chunkBytes = uint64_t(lines) * uint64_t(w) * pixelBytes;
+        chunk = "blocks of " + std::to_string(lines) + " lines";
+    }
+    checkMemory(path, "the EXR's floats and OpenEXR's " + std::to_string(buffers) + " decoding buffers for its " + chunk +
+                          (tileRow ? " and a row of them" : "") + " (" + std::to_string(w) + " pixels wide, " +
+                          std::to_string(pixelBytes) + " bytes a pixel)",
+                buffers * 4 * chunkBytes + tileRow + floats);
+}
+
+}  // namespace
+
 ExrImage readExr(const std::string& path) {
     if (const std::string why = notARegularFile(path); !why.empty()) throw Error(path, why);
     // OpenEXR allocates from the header as it opens a file (an offset per line block: 1 GB for a
@@ -139,17 +228,18 @@ ExrImage readExr(const std::string& path) {
         Imf::Header::setMaxImageSize(kMaxImageSide, kMaxImageSide);
         Imf::Header::setMaxTileSize(kMaxImageSide, kMaxImageSide);
     });
+    const int threads = exrThreads();
+    checkExrHeader(path, threads);
     try {
-        Imf::InputFile file(path.c_str(), exrThreads());
+        Imf::InputFile file(path.c_str(), threads);
         const Imath::Box2i dw = file.header().dataWindow();
-        // In 64 bits: a window from INT_MIN to INT_MAX is 2^32 pixels wide.
+        // The header as the C++ library read it, checked again: the same bytes, but not the same parser.
         const int64_t w = int64_t(dw.max.x) - dw.min.x + 1, h = int64_t(dw.max.y) - dw.min.y + 1;
         if (w <= 0 || h <= 0) throw Error(path, "the EXR's data window is empty");
         if (const std::string why = oversize("EXR", uint64_t(w), uint64_t(h)); !why.empty()) throw Error(path, why);
         const Imf::ChannelList& list = file.header().channels();
         uint64_t count = 0;
         for (auto it = list.begin(); it != list.end(); ++it) ++count;
-        // Every channel is read as w x h floats, allocated before any pixel is read.
         checkMemory(path, "the EXR's " + std::to_string(count) + " channels of " + std::to_string(w) + "x" +
                               std::to_string(h) + " floats",
                     count * uint64_t(w) * uint64_t(h) * sizeof(float));

@@ -1,0 +1,30 @@
+// What a render will hold at its peak, estimated from the scene's resolution and the options
+// before anything is built, so that a render too large for the machine is a clear error at once
+// (core/memory_limit.h) instead of an out-of-memory kill minutes later. Used by `wedge render`
+// and, for each render it keeps images of, by `wedge experiment`.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include "render/renderer.h"
+#include "scene/scene_desc.h"
+
+namespace wedge::render {
+
+/// The samples per pixel `render` uses for these options: --spp, else the scene's for mc and 16
+/// for the filtering methods.
+int renderSpp(const scene::SceneDesc& desc, const RenderOptions& options);
+
+/// The peak bytes of render(scene, options) for this scene description, and what it is made of
+/// ("a 512x512 mc render" and, where the layers keep their samples, "keeping 16 samples a pixel").
+struct RenderMemory {
+    uint64_t bytes = 0;
+    std::string what;
+};
+RenderMemory renderMemory(const scene::SceneDesc& desc, const RenderOptions& options);
+
+/// Throws wedge::Error naming the scene file when renderMemory's bytes exceed the memory limit.
+void checkRenderMemory(const scene::SceneDesc& desc, const RenderOptions& options);
+
+}  // namespace wedge::render
