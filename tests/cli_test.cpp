@@ -485,3 +485,20 @@ TEST(Cli, ARenderTooLargeForTheMemoryLimitIsRefusedBeforeItStarts) {
     EXPECT_FALSE(fs::exists(dir + "/a.png"));
     EXPECT_EQ(runWedge("render " + dir + "/good.json --method maaf --quiet --max-memory 1G -o " + dir + "/a.png", nullptr, &err), 0) << err;
 }
+
+TEST(Cli, ARenderKeepingItsSamplesForTheLayersCountsThem) {
+    // With a lens the layers keep every sample (24 bytes) until they reconstruct: 8x8 pixels at
+    // 64 spp add 96 KiB to the 75 KiB of the render's buffers; without a lens nothing is kept.
+    std::string dir = tempDir(), err;
+    writeFile(dir + "/lens.json", scene(kSphere, "\"fov_y\": 40", "\"fov_y\": 40, \"aperture_radius\": 0.05, \"focus_distance\": 3"));
+    writeFile(dir + "/pinhole.json", scene(kSphere));
+    EXPECT_EQ(runWedge("render " + dir + "/lens.json --spp 64 --layers on --quiet --max-memory 128K -o " + dir + "/a.png", nullptr, &err), 2);
+    EXPECT_NE(err.find("lens.json: a 8x8 mc render keeping its 64 samples a pixel for the layers (--layers) needs 171.0 KiB, "
+                       "more than the memory limit of 128.0 KiB (--max-memory)"),
+              std::string::npos)
+        << err;
+    EXPECT_FALSE(fs::exists(dir + "/a.png"));
+    EXPECT_EQ(runWedge("render " + dir + "/lens.json --spp 64 --layers off --quiet --max-memory 128K -o " + dir + "/a.png", nullptr, &err), 0) << err;
+    EXPECT_EQ(runWedge("render " + dir + "/pinhole.json --spp 64 --layers on --quiet --max-memory 128K -o " + dir + "/b.png", nullptr, &err), 0) << err;
+}
+

@@ -7,9 +7,9 @@
 #include "apps/wedge/mpi_session.h"
 #include "apps/wedge/render_flags.h"
 #include "core/error.h"
-#include "core/memory_limit.h"
 #include "core/parallel.h"
 #include "io/image_io.h"
+#include "render/memory_estimate.h"
 #include "render/output.h"
 #include "scene/scene.h"
 #include "scene/scene_loader.h"
@@ -24,23 +24,6 @@ struct RenderArgs {
     std::string stats;
     RenderFlags flags;
 };
-
-/// The peak memory of a render per pixel, measured (/usr/bin/time, cornell at 512x512 less
-/// 128x128, default options): mc 0.67 KB, atrous 0.66, aaf 0.72, maaf 1.0. Rounded up.
-constexpr uint64_t kRenderBytesPerPixel = 1200;
-/// MAAF's --maaf-keep-records keeps every initial sample: 64 bytes each (SampleRecord).
-constexpr uint64_t kRecordBytes = 64;
-
-/// The resolution (a scene's or --resolution's) against the memory limit before the scene is
-/// built: a 16384 x 16384 render needs about 300 GB, and was an out-of-memory kill.
-void checkRenderMemory(const scene::SceneDesc& desc, const render::RenderOptions& opt) {
-    const uint64_t pixels = uint64_t(desc.camera.width) * uint64_t(desc.camera.height);
-    uint64_t perPixel = kRenderBytesPerPixel;
-    if (opt.method == "maaf" && opt.maafKeepRecords) perPixel += uint64_t(opt.spp.value_or(desc.render.spp)) * kRecordBytes;
-    checkMemory(desc.file, "a " + std::to_string(desc.camera.width) + "x" + std::to_string(desc.camera.height) + " " +
-                               opt.method + " render",
-                pixels * perPixel);
-}
 
 void runRender(const RenderArgs& a) {
     // Under mpirun every rank renders its share (docs/mpi.md); rank 0 alone speaks and writes.
@@ -59,7 +42,9 @@ void runRender(const RenderArgs& a) {
     scene::SceneDesc desc = scene::loadScene(a.scene);
     if (root) printWarnings(desc);
     a.flags.applyTo(desc);
-    checkRenderMemory(desc, opt);
+    // The resolution against the memory limit before the scene is built: a 16384 x 16384 render
+    // needs about 300 GB, and was an out-of-memory kill.
+    render::checkRenderMemory(desc, opt);
     scene::Scene scene(std::move(desc));
     const uint64_t bytesBefore = mpi.bytesExchanged();
     render::RenderResult result = render::render(scene, opt);

@@ -13,7 +13,9 @@ namespace {
 constexpr uint64_t kRenderBytesPerPixel = 1200;
 /// MAAF's --maaf-keep-records keeps every initial sample: 64 bytes each (SampleRecord).
 constexpr uint64_t kRecordBytes = 64;
-/// The layers keep every sample (core/light_field.h) until they reconstruct.
+/// The layers keep every sample (core/light_field.h) until they reconstruct: 24 bytes each,
+/// within the 1200 a pixel the rest of their stage needs (measured, cornell's lens, mc at 32 spp,
+/// 256x256: 786 bytes a pixel with --layers off, 1647 with them on, 1968 estimated).
 constexpr uint64_t kLightFieldSampleBytes = sizeof(LightFieldSample);
 
 }  // namespace
