@@ -502,3 +502,29 @@ TEST(Cli, ARenderKeepingItsSamplesForTheLayersCountsThem) {
     EXPECT_EQ(runWedge("render " + dir + "/pinhole.json --spp 64 --layers on --quiet --max-memory 128K -o " + dir + "/b.png", nullptr, &err), 0) << err;
 }
 
+TEST(Cli, ARasterTooLargeForTheMemoryLimitIsRefusedBeforeItStarts) {
+    std::string dir = tempDir(), err;
+    writeFile(dir + "/good.json", scene(kSphere));
+    const std::string g = "raster " + dir + "/good.json --quiet --max-memory 1G ";
+    struct Case { std::string args, expect; };
+    for (const Case& c : std::vector<Case>{
+             // The visibility samples: 2^30 at 64 bytes.
+             {g + "--resolution 4096x4096 --spp 64 -o " + dir + "/a.png",
+              "good.json: a 4096x4096 raster at 64 spp (1073741824 samples, at 64 bytes) with a shading cache of 64 "
+              "entries (--cache-entries) needs 65.0 GiB, more than the memory limit of 1.0 GiB (--max-memory)"},
+             // The cache's nodes and map, allocated whole when the cache is made.
+             {g + "--cache-entries 1073741824 -o " + dir + "/a.png", "with a shading cache of 1073741824 entries (--cache-entries) needs 64.0 GiB"},
+             // A --truth-spp pass (64 spp at most) beside the render's samples.
+             {g + "--resolution 2048x2048 --spp 1 --truth-spp 4096 -o " + dir + "/a.png",
+              "a 2048x2048 raster at 1 spp (4194304 samples, and 268435456 of a --truth-spp pass, at 64 bytes)"},
+             // The sweep's largest cache; no --out folder is made.
+             {g + "--sweep-cache 16,1073741824 --out " + dir + "/sweep", "a shading cache of 1073741824 entries (--cache-entries)"}}) {
+        EXPECT_EQ(runWedge(c.args, nullptr, &err), 2) << c.args << "\n" << err;
+        EXPECT_NE(err.find(c.expect), std::string::npos) << c.args << "\n" << err;
+        EXPECT_FALSE(fs::exists(dir + "/a.png"));
+        EXPECT_FALSE(fs::exists(dir + "/sweep"));
+    }
+    EXPECT_EQ(runWedge(g + "--resolution 8x8 --spp 4 --no-reference -o " + dir + "/a.png", nullptr, &err), 0) << err;
+    EXPECT_TRUE(fs::exists(dir + "/a.png"));
+}
+

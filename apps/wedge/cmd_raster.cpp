@@ -77,14 +77,15 @@ void runSweep(const RasterArgs& a) {
     if (!a.stats.empty()) io::checkOutputPath(a.stats, {".json"});
     std::error_code ec;
     if (fs::exists(a.outDir) && !fs::is_directory(a.outDir)) throw Error("--out " + a.outDir, "not a directory");
-    fs::create_directories(a.outDir, ec);
-    if (ec) throw Error("--out " + a.outDir, "cannot create the directory: " + ec.message());
 
     ThreadLimit limit(a.threads);
     scene::SceneDesc desc = loadRasterScene(a.scene);
     applyResolution(desc, a.resolution);
     raster::SweepResult sweep = raster::sweepCache(desc, options(a, desc), a.sweep);
 
+    // Made once there is something to write: a sweep refused (bad input, the memory limit) leaves none.
+    fs::create_directories(a.outDir, ec);
+    if (ec) throw Error("--out " + a.outDir, "cannot create the directory: " + ec.message());
     fs::path dir(a.outDir);
     io::writeTextFile((dir / "sweep.csv").string(), raster::sweepCsv(sweep));
     writeJsonFile((dir / "sweep.json").string(), raster::sweepJson(sweep, a.scene));
