@@ -528,3 +528,17 @@ TEST(Cli, ARasterTooLargeForTheMemoryLimitIsRefusedBeforeItStarts) {
     EXPECT_TRUE(fs::exists(dir + "/a.png"));
 }
 
+TEST(Cli, AnExperimentTooLargeForTheMemoryLimitIsRefusedBeforeItStarts) {
+    std::string dir = tempDir(), err;
+    writeFile(dir + "/good.json", scene(kSphere));
+    // The reference's two halves (each a 4096x4096 mc render: 18.8 GiB) before anything is written.
+    EXPECT_EQ(runWedge("experiment " + dir + "/good.json --methods mc --spp 4 --reference-spp 8 --resolution 4096x4096 "
+                       "--quiet --max-memory 1G --out " + dir + "/e",
+                       nullptr, &err),
+              2);
+    EXPECT_NE(err.find("good.json: an experiment at 4096x4096 (its largest render, 37.5 GiB, beside the reference and the 1 "
+                       "base rows' images) needs 38.2 GiB, more than the memory limit of 1.0 GiB (--max-memory)"),
+              std::string::npos)
+        << err;
+    EXPECT_FALSE(fs::exists(dir + "/e"));
+}

@@ -10,6 +10,7 @@
 #include <unistd.h>
 
 #include "core/error.h"
+#include "core/memory_limit.h"
 #include "core/parallel.h"
 #include "core/sampler.h"
 #include "io/image_io.h"
@@ -17,6 +18,7 @@
 #include "io/output_file.h"
 #include "io/text_file.h"
 #include "render/distribution.h"
+#include "render/memory_estimate.h"
 
 namespace fs = std::filesystem;
 
@@ -170,6 +172,12 @@ private:
         o.quiet = quiet;
         return o;
     }
+    /// The experiment's certain need against the memory limit before anything is rendered or
+    /// written: the reference's two halves (the first kept while the second renders) or the
+    /// largest base render, with the reference and the base rows' images beside it.
+    void checkMemoryAhead() const;
+    /// The bytes of the images held now: the reference, every probe's and the rows' copies.
+    uint64_t keptBytes() const;
     /// Renders `method` at `spp` (memoised per method); nullopt when the method is not available.
     const ExperimentProbe* evaluate(const std::string& method, int spp);
     void searchEqualQuality(const std::string& method, double target);
@@ -250,10 +258,50 @@ void Experiment::loadOrRenderReference() {
     io::writeTextFile(meta.string(), j.dump(2) + "\n");
 }
 
+void Experiment::checkMemoryAhead() const {
+    const scene::SceneDesc& desc = m_scene.desc();
+    const uint64_t pixels = uint64_t(desc.camera.width) * uint64_t(desc.camera.height);
+    RenderOptions ref = renderOptions("mc", m_options.referenceSpp - m_options.referenceSpp / 2, 0, true);
+    ref.layers = "off";  // as loadOrRenderReference renders it
+    uint64_t renders = 2 * renderMemory(desc, ref).bytes;
+    for (const auto& m : m_options.methods)
+        renders = std::max(renders, renderMemory(desc, renderOptions(m, m_options.spp, 0, true)).bytes);
+    // The reference (12 bytes a pixel) and, per method, its base probe, the row's copy of it (12
+    // and 1 byte a pixel each: colour and pixel classes) and its variance map (4).
+    const uint64_t images = pixels * (sizeof(Vec3f) + m_options.methods.size() * (2 * (sizeof(Vec3f) + 1) + sizeof(float)));
+    checkMemory(desc.file,
+                "an experiment at " + std::to_string(desc.camera.width) + "x" + std::to_string(desc.camera.height) +
+                    " (its largest render, " + formatBytes(double(renders)) + ", beside the reference and the " +
+                    std::to_string(m_options.methods.size()) + " base rows' images)",
+                renders + images);
+}
+
+uint64_t Experiment::keptBytes() const {
+    uint64_t n = m_reference.size() * sizeof(Vec3f);
+    auto add = [&](const ExperimentProbe& p) { n += p.color.size() * sizeof(Vec3f) + p.regions.size(); };
+    for (const auto& [method, probes] : m_memo)
+        for (const auto& [spp, p] : probes) add(p);
+    for (const auto& row : m_result.rows) {
+        add(row.probe);
+        for (const auto& p : row.probes) add(p);
+    }
+    return n;
+}
+
 const ExperimentProbe* Experiment::evaluate(const std::string& method, int spp) {
     auto& memo = m_memo[method];
     if (auto it = memo.find(spp); it != memo.end()) return &it->second;
     RenderOptions o = renderOptions(method, spp, m_result.seed, m_options.quiet);
+    // The searches keep every probe's image (and the rows copies of them): checked before each
+    // render, with what is held so far, as the grid grows.
+    {
+        const RenderMemory r = renderMemory(m_scene.desc(), o);
+        const uint64_t kept = keptBytes();
+        checkMemory(m_scene.desc().file,
+                    r.what + " at " + std::to_string(spp) + " spp beside the experiment's " + formatBytes(double(kept)) +
+                        " of images kept so far",
+                    r.bytes + kept + uint64_t(m_result.width) * uint64_t(m_result.height) * (sizeof(Vec3f) + 1));
+    }
     RenderResult r;
     try {
         r = render(m_scene, o);
@@ -348,6 +396,8 @@ ExperimentResult Experiment::run() {
     m_result.referenceSeed = hashCombine(m_result.seed, 0x72656672U);
     m_result.referenceSpp = m_options.referenceSpp;
     m_cap = m_options.maxSpp > 0 ? m_options.maxSpp : std::max(m_options.spp, m_options.referenceSpp / 4);
+
+    checkMemoryAhead();  // before anything is written
 
     if (m_options.writes) fs::create_directories(fs::path(m_options.outDir) / "images");
     if (m_options.cacheDir.empty()) m_options.cacheDir = (fs::path(m_options.outDir) / "cache").string();
