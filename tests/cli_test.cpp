@@ -70,6 +70,23 @@ TEST(Cli, GoodSceneRenders) {
     const auto stats = nlohmann::json::parse(readFile(dir + "/s.json"));
     ASSERT_TRUE(stats.contains("nonfinite_pixels")) << stats.dump();
     EXPECT_EQ(stats["nonfinite_pixels"], 0);
+    ASSERT_TRUE(stats.contains("nonfinite_samples")) << stats.dump();
+    EXPECT_EQ(stats["nonfinite_samples"], 0);
+}
+
+TEST(Cli, StatsCountTheSamplesWhoseLightIsNotFinite) {
+    // A radiance within float range (3e38) over a 10 x 10 light overflows the irradiance of the
+    // samples that see it to infinity: counted per sample, beside the pixels they reach.
+    std::string dir = tempDir(), err;
+    writeFile(dir + "/hot.json", scene(kSphere, "\"edge1\": [1, 0, 0], \"edge2\": [0, 0, 1], \"radiance\": [5, 5, 5]",
+                                       "\"edge1\": [10, 0, 0], \"edge2\": [0, 0, 10], \"radiance\": [3e38, 3e38, 3e38]"));
+    EXPECT_EQ(runWedge("render " + dir + "/hot.json --method mc --spp 2 --quiet --stats " + dir + "/s.json", nullptr, &err), 0) << err;
+    const auto stats = nlohmann::json::parse(readFile(dir + "/s.json"));
+    const double samples = stats.value("nonfinite_samples", -1.0), pixels = stats.value("nonfinite_pixels", -1.0);
+    EXPECT_GT(samples, 0) << stats.dump();
+    EXPECT_LE(samples, 8 * 8 * 2) << "at most every sample of the 8x8 render at 2 spp";
+    EXPECT_GT(pixels, 0) << stats.dump();
+    EXPECT_NE(err.find("pixels have non-finite"), std::string::npos) << err;
 }
 
 TEST(Cli, TheExrFileIsTheSameOnAnyNumberOfThreads) {

@@ -307,6 +307,13 @@ void PathSampler::traceBatch(int x, int y, uint32_t first, uint32_t count, bool 
                 // demodulated indirect is the incident radiance L = albedo2 E2 / pi.
                 out[k].record.indirect = h2[k].albedo * l2[k].irradiance * kInvPi;
     }
+    uint64_t bad = 0;
+    for (uint32_t i = 0; i < count; ++i) {
+        const TracedSample& o = outs[i];
+        bad += !(isFinite(o.emission) && isFinite(o.record.direct) && isFinite(o.record.indirect) &&
+                 std::isfinite(o.record.unoccluded));
+    }
+    if (bad > 0) m_nonFinite.fetch_add(bad, std::memory_order_relaxed);
 }
 
 Vec3f PathSampler::meanEmission(int x, int y, uint32_t count) const {

@@ -6,6 +6,7 @@
 // only on (seed, pixel, sample index).
 #pragma once
 
+#include <atomic>
 #include <cstdint>
 #include <vector>
 
@@ -79,6 +80,10 @@ public:
     int ranks() const { return m_ranks; }
     /// Whether this rank traces row y (render/distribution.h, ownsRow).
     bool tracesRow(int y) const { return m_ranks <= 1 || y % m_ranks == m_rank; }
+    /// The samples traced so far whose light (emission, direct, indirect or unoccluded) is not
+    /// finite: a scene's extreme numbers overflowing a float on the way. There should be none;
+    /// --stats reports them (nonfinite_samples) beside the pixels they reach.
+    uint64_t nonFiniteSamples() const { return m_nonFinite.load(std::memory_order_relaxed); }
     const scene::Scene& scene() const { return m_scene; }
     ViewGeometry view() const;
     /// The lights' closed-form irradiance at x (normal n), without occlusion
@@ -111,6 +116,7 @@ private:
     uint32_t m_seed;
     float m_epsilon;
     bool m_needChoice;  // light choice or shutter time vary
+    mutable std::atomic<uint64_t> m_nonFinite{0};
     std::vector<float> m_lightCdf;     // light choice proportional to power
     std::vector<uint32_t> m_group;     // scene light -> its group, the ViewGeometry light (scene::lightGroups)
     std::vector<Vec3f> m_groupCenter;  // each group's centroid

@@ -201,6 +201,10 @@ RenderResult render(const scene::Scene& scene, const RenderOptions& options) {
     result.raysPerRank = gatherCounts(sampler.distribution(), result.rays);
     result.rays = 0;
     for (uint64_t r : result.raysPerRank) result.rays += r;
+    // And the samples whose light is not finite (--stats nonfinite_samples), over every rank.
+    uint64_t nonFinite = 0;
+    for (uint64_t n : gatherCounts(sampler.distribution(), sampler.nonFiniteSamples())) nonFinite += n;
+    result.extra.emplace_back("nonfinite_samples", double(nonFinite));
     result.seconds.add("total", total.seconds());
     shareRootTimes(sampler.distribution(), result.seconds);  // every rank returns the same result
     return result;
