@@ -149,9 +149,10 @@ uint64_t exrTypeBytes(exr_pixel_type_t t) { return t == EXR_PIXEL_HALF ? 2 : 4; 
 /// the largest wedge reads, and refuses what the C++ library would allocate past the memory limit
 /// as it opens the file: it reads an attribute by allocating the size the header declares (2 GB
 /// from a few bytes: what held fuzz_exr to 30 executions a second), and sizes its decoding buffers
-/// from the header (one per thread and one more, each a chunk of lines or a tile, and about three
-/// times that again in the decompressor's scratch) before reading a pixel.
-void checkExrHeader(const std::string& path, int threads) {
+/// from the header (two a thread, each a chunk of lines or a tile, and up to three times that
+/// again in the decompressor's scratch) before reading a pixel. Returns the threads to open it
+/// with: `threads` at most, fewer where the image has fewer chunks.
+int checkExrHeader(const std::string& path, int threads) {
     std::string why;
     exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
     init.error_handler_fn = keepExrCoreError;
@@ -192,6 +193,11 @@ void checkExrHeader(const std::string& path, int threads) {
     // OpenEXR's buffers: one chunk (a block of lines, or a tile) a buffer as the file stores it,
     // and up to three times that in its decompressor (B44's scratch is twice the chunk); a tiled
     // file read as lines also goes through a row of tiles in floats.
+    // The library makes two buffers a thread (one without threads): no more threads than it has
+    // chunks to fill two buffers each, so a small image does not get the buffers of a large one.
+    int32_t chunks = 1;
+    if (exr_get_chunk_count(ctxt, 0, &chunks) != EXR_ERR_SUCCESS || chunks < 1) chunks = 1;
+    threads = std::min(threads, chunks / 2);
     const uint64_t buffers = uint64_t(std::max(1, 2 * threads));
     uint64_t chunkBytes = 0, tileRow = 0;
     std::string chunk;
@@ -210,10 +216,11 @@ void checkExrHeader(const std::string& path, int threads) {
         chunkBytes = uint64_t(lines) * uint64_t(w) * pixelBytes;
         chunk = "blocks of " + std::to_string(lines) + " lines";
     }
-    checkMemory(path, "the EXR's floats and OpenEXR's " + std::to_string(buffers) + " decoding buffers for its " + chunk +
-                          (tileRow ? " and a row of them" : "") + " (" + std::to_string(w) + " pixels wide, " +
+    checkMemory(path, "the EXR's floats and OpenEXR's decoding buffers (" + std::to_string(buffers) + " for its " + chunk +
+                          (tileRow ? ", and a row of them" : "") + ", " + std::to_string(w) + " pixels wide, " +
                           std::to_string(pixelBytes) + " bytes a pixel)",
                 buffers * 4 * chunkBytes + tileRow + floats);
+    return threads;
 }
 
 }  // namespace
@@ -228,8 +235,7 @@ ExrImage readExr(const std::string& path) {
         Imf::Header::setMaxImageSize(kMaxImageSide, kMaxImageSide);
         Imf::Header::setMaxTileSize(kMaxImageSide, kMaxImageSide);
     });
-    const int threads = exrThreads();
-    checkExrHeader(path, threads);
+    const int threads = checkExrHeader(path, exrThreads());
     try {
         Imf::InputFile file(path.c_str(), threads);
         const Imath::Box2i dw = file.header().dataWindow();
