@@ -20,10 +20,6 @@ constexpr uint64_t kLightFieldSampleBytes = sizeof(LightFieldSample);
 
 }  // namespace
 
-int renderSpp(const scene::SceneDesc& desc, const RenderOptions& options) {
-    return options.spp.value_or(options.method == "mc" ? desc.render.spp : 16);
-}
-
 RenderMemory renderMemory(const scene::SceneDesc& desc, const RenderOptions& options) {
     const uint64_t pixels = uint64_t(desc.camera.width) * uint64_t(desc.camera.height);
     const int spp = renderSpp(desc, options);
@@ -35,9 +31,8 @@ RenderMemory renderMemory(const scene::SceneDesc& desc, const RenderOptions& opt
         perPixel += uint64_t(spp) * kRecordBytes;
         m.what += " keeping its " + std::to_string(spp) + " sample records a pixel (--maaf-keep-records)";
     }
-    // As render() decides it: the layers keep the light field where the camera has a lens or the
-    // scene moves (at least the initial samples; the adaptive ones are checked as they are added).
-    if (spp > 0 && options.layered(spp) && (desc.camera.apertureRadius > 0 || desc.hasMotion())) {
+    // At least the initial samples; the adaptive ones are checked as they are added.
+    if (spp > 0 && keepsLightField(desc, options, spp)) {
         perPixel += uint64_t(spp) * kLightFieldSampleBytes;
         m.what += " keeping its " + std::to_string(spp) + " samples a pixel for the layers (--layers)";
     }

@@ -12,10 +12,6 @@
 
 namespace wedge::render {
 
-/// The samples per pixel `render` uses for these options: --spp, else the scene's for mc and 16
-/// for the filtering methods.
-int renderSpp(const scene::SceneDesc& desc, const RenderOptions& options);
-
 /// The peak bytes of render(scene, options) for this scene description, and what it is made of
 /// ("a 512x512 mc render" and, where the layers keep their samples, "keeping 16 samples a pixel").
 struct RenderMemory {

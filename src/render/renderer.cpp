@@ -163,6 +163,14 @@ void renderMc(const MethodContext& ctx, RenderResult& result) {
     result.color = ctx.lightField ? reconstructFromLayers(ctx, {}, result) : result.buffers.color;
 }
 
+int renderSpp(const scene::SceneDesc& desc, const RenderOptions& options) {
+    return options.spp.value_or(options.method == "mc" ? desc.render.spp : 16);
+}
+
+bool keepsLightField(const scene::SceneDesc& desc, const RenderOptions& options, int spp) {
+    return options.layered(spp) && (desc.camera.apertureRadius > 0 || desc.hasMotion());
+}
+
 RenderResult render(const scene::Scene& scene, const RenderOptions& options) {
     const auto known = methods();
     if (std::find(known.begin(), known.end(), options.method) == known.end()) {
@@ -172,19 +180,17 @@ RenderResult render(const scene::Scene& scene, const RenderOptions& options) {
     }
     const scene::SceneDesc& desc = scene.desc();
     uint32_t seed = options.seed.value_or(desc.render.seed);
-    int spp = options.spp.value_or(options.method == "mc" ? desc.render.spp : 16);
+    const int spp = renderSpp(desc, options);
     if (spp <= 0) throw Error("--spp", "expected a positive number of samples per pixel");
 
     Timer total;
     Camera camera(desc.camera);
     PathSampler sampler(scene, camera, desc.render.indirect, seed);
     if (const Distribution* d = options.distribution; d && d->ranks() > 1) sampler.distribute(d, d->rank(), d->ranks());
-    // The light field is kept where reconstructing across pixels can change anything: a lens or
-    // motion (without either, every layer is sharp and the result is each pixel's own samples).
     LightFieldSamples lightField;
     if (options.layers != "auto" && options.layers != "on" && options.layers != "off")
         throw Error("--layers", "expected auto, on or off, got '" + options.layers + "'");
-    const bool layered = options.layered(spp) && (camera.hasLens() || desc.hasMotion());
+    const bool layered = keepsLightField(desc, options, spp);
     if (layered) lightField = LightFieldSamples(desc.camera.width, desc.camera.height);
     MethodContext ctx{scene, options, sampler, sampler.view(), spp, layered ? &lightField : nullptr};
 

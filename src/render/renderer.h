@@ -86,6 +86,14 @@ struct RenderResult {
 /// The methods `render` knows, in the order `wedge render --help` lists them.
 std::vector<std::string> methods();
 
+/// The samples per pixel `render` uses for these options: --spp, else the scene's for mc and 16
+/// for the filtering methods.
+int renderSpp(const scene::SceneDesc& desc, const RenderOptions& options);
+/// Whether `render` keeps the light field (every sample, for the layered reconstruction): where
+/// the options reconstruct with layers at `spp` and there is something to reconstruct across
+/// pixels, a lens or motion (without either every layer is sharp: each pixel's own samples).
+bool keepsLightField(const scene::SceneDesc& desc, const RenderOptions& options, int spp);
+
 RenderResult render(const scene::Scene& scene, const RenderOptions& options);
 
 }  // namespace wedge::render
