@@ -436,6 +436,48 @@ TEST(Render, TheSamplesThatChooseALightAreStratifiedOverIt) {
         }
 }
 
+TEST(Render, PixelsTracedTogetherAreThePixelsTracedAlone) {
+    // samplePixels traces several pixels' samples as one wave (their shadow rays and bounces as
+    // Embree streams): each sample must be what tracing its pixel alone gives, bit for bit,
+    // whatever the wave's other pixels, counts and spans.
+    scene::Scene s(parse(kPlankUnderLens));
+    render::Camera camera(s.desc().camera);
+    render::PathSampler sampler(s, camera, true, 3);
+    std::vector<render::PathSampler::SampleRun> runs;
+    uint32_t total = 0;
+    for (int i = 0; i < 40; ++i) {
+        const uint32_t count = uint32_t(i * 7 % 23), first = uint32_t(i % 5) * 3;  // 0 .. 22 samples, some empty
+        runs.push_back({(i * 5) % 32, (i * 3) % 32, first, count, nullptr});
+        total += count;
+    }
+    for (bool span : {false, true}) {
+        std::vector<render::TracedSample> together(total), alone(total);
+        uint32_t offset = 0;
+        for (auto& r : runs) {
+            r.out = together.data() + offset;
+            sampler.traceBatch(r.x, r.y, r.first, r.count, span, alone.data() + offset);
+            offset += r.count;
+        }
+        sampler.traceMany(runs.data(), runs.size(), span);
+        int hits = 0, bounces = 0;
+        for (uint32_t i = 0; i < total; ++i) {
+            const render::TracedSample &a = together[i], &b = alone[i];
+            ASSERT_EQ(a.hit, b.hit) << i;
+            hits += a.hit;
+            bounces += a.bounceHit;
+            EXPECT_EQ(a.occluded, b.occluded) << i;
+            EXPECT_EQ(a.bounceHit, b.bounceHit) << i;
+            EXPECT_EQ(a.rays, b.rays) << i;
+            EXPECT_EQ(a.tNear, b.tNear) << i;
+            EXPECT_EQ(a.tFar, b.tFar) << i;
+            EXPECT_EQ(0, std::memcmp(&a.record, &b.record, sizeof(SampleRecord))) << i;
+            EXPECT_EQ(0, std::memcmp(&a.position, &b.position, sizeof(Vec3f))) << i;
+        }
+        EXPECT_GT(hits, int(total) / 2);
+        EXPECT_GT(bounces, 0);
+    }
+}
+
 TEST(Render, SamplesTracedAgainAreTheSamplesAndFindTheirSlot) {
     // What lets MAAF trace the samples of its outer-component pixels again instead of keeping
     // them: the sampler is deterministic per pixel and sample index (whatever the batches and

@@ -2,6 +2,7 @@
 // checks of OBJ and MTL text.
 #include <gtest/gtest.h>
 
+#include <cstring>
 #include <filesystem>
 #include <random>
 #include <tuple>
@@ -226,6 +227,66 @@ TEST(Scene, OccluderSpanOfManyAndOfOneOccluder) {
     expectSpan(s.occluders({6, 0, 0}, {0, 0, 1}, 0.f, 3.f, 0), 1.2f, 1.2f);
     // A segment ending between the occluders sees only those before its end.
     expectSpan(s.occluders({0, 0, 0}, {0, 0, 1}, 0.f, 2.f, 0), 1.f, 1.7f);
+}
+
+TEST(Scene, StreamQueriesAreTheSingleRayQueries) {
+    // The sampler traces several pixels' rays as one Embree stream; whatever a stream's length
+    // and whichever rays share it, every ray must get what it gets alone (bit for bit: the same
+    // seed gives the same image on any number of threads or ranks).
+    SceneDesc d = oneQuad();
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<float> u(-1.f, 1.f);
+    TriangleMesh m;  // 400 small quads at random heights and tilts over the floor
+    for (int i = 0; i < 400; ++i)
+        appendQuad(m, {2 * u(rng), 2 * u(rng), 1.5f + u(rng)}, {0.3f, 0.1f * u(rng), 0.1f * u(rng)},
+                   {0.1f * u(rng), 0.3f, 0.1f * u(rng)}, 0);
+    d.meshes.push_back(m);
+    Scene s(std::move(d));
+    std::vector<RaySegment> rays;
+    for (int i = 0; i < 700; ++i) {
+        const Vec3f org{2 * u(rng), 2 * u(rng), 0.01f}, dir = normalize(Vec3f{u(rng), u(rng), 0.5f + 0.5f * std::abs(u(rng))});
+        rays.push_back({org, dir, i % 3 == 0 ? 10.f : 3.f * std::abs(u(rng)), 0.f});
+    }
+    const size_t n = rays.size();
+    std::vector<Hit> hits(n);
+    std::vector<char> found(n), occ(n);
+    std::vector<OccluderSpan> spans(n);
+    int hitCount = 0, spanCount = 0;
+    for (size_t i = 0; i < n; ++i) {
+        found[i] = s.intersect(rays[i].org, rays[i].dir, 0.f, rays[i].tFar, 0.f, hits[i]);
+        occ[i] = s.occluded(rays[i].org, rays[i].dir, 0.f, rays[i].tFar, 0.f);
+        spans[i] = s.occluders(rays[i].org, rays[i].dir, 0.f, rays[i].tFar, 0.f);
+        hitCount += found[i];
+        spanCount += spans[i].occluded && spans[i].tFar > spans[i].tNear;
+    }
+    ASSERT_GT(hitCount, 100);
+    ASSERT_LT(hitCount, 650);
+    ASSERT_GT(spanCount, 20);  // rays that pass several quads
+    for (size_t chunk : {size_t(1), size_t(13), size_t(256), n}) {
+        std::vector<Hit> h(n);
+        bool f[700], o[700];
+        std::vector<OccluderSpan> sp(n);
+        for (size_t b = 0; b < n; b += chunk) {
+            const size_t c = std::min(chunk, n - b);
+            s.intersect(rays.data() + b, c, h.data() + b, f + b);
+            s.occluded(rays.data() + b, c, o + b);
+            s.occluders(rays.data() + b, c, sp.data() + b);
+        }
+        for (size_t i = 0; i < n; ++i) {
+            ASSERT_EQ(f[i], bool(found[i])) << "chunk " << chunk << " ray " << i;
+            EXPECT_EQ(o[i], bool(occ[i])) << "chunk " << chunk << " ray " << i;
+            EXPECT_EQ(sp[i].occluded, spans[i].occluded) << "chunk " << chunk << " ray " << i;
+            if (sp[i].occluded) {
+                EXPECT_EQ(sp[i].tNear, spans[i].tNear);
+                EXPECT_EQ(sp[i].tFar, spans[i].tFar);
+            }
+            if (!f[i]) continue;
+            EXPECT_EQ(0, std::memcmp(&h[i].position, &hits[i].position, sizeof(Vec3f))) << "chunk " << chunk << " ray " << i;
+            EXPECT_EQ(0, std::memcmp(&h[i].normal, &hits[i].normal, sizeof(Vec3f)));
+            EXPECT_EQ(h[i].t, hits[i].t);
+            EXPECT_EQ(h[i].object, hits[i].object);
+        }
+    }
 }
 
 TEST(Scene, SphereNormalPointsOutward) {

@@ -220,17 +220,20 @@ void renderMaaf(const MethodContext& ctx, RenderResult& result) {
     if (retrace) parallelRows(H, [&](int y) {
         if (!ctx.sampler.tracesRow(y)) return;  // over several ranks, each its own rows
         uint64_t rays = 0;
-        TracedSample batch[16];
-        for (int x = 0; x < W; ++x) {
-            const size_t p = size_t(y) * W + x;
-            if (!outer(p)) continue;
-            for (uint32_t first = 0; first < n0; first += 16) {
-                const uint32_t n = std::min<uint32_t>(16, n0 - first);
-                ctx.sampler.traceBatch(x, y, first, n, false, batch);
-                for (uint32_t k = 0; k < n; ++k) {
-                    rays += batch[k].rays;
-                    records[offset[p] + first + k] = filter::MaafSample::pack(batch[k].record, view, stats[p].slotOf(batch[k]));
-                }
+        // The row's pixels with outer components, traced together (PathSampler::traceMany).
+        std::vector<PathSampler::SampleRun> runs;
+        for (int x = 0; x < W; ++x)
+            if (outer(size_t(y) * W + x)) runs.push_back({x, y, 0, n0, nullptr});
+        std::vector<TracedSample> traced(runs.size() * n0);
+        for (size_t i = 0; i < runs.size(); ++i) runs[i].out = traced.data() + i * n0;
+        const size_t perCall = std::max<size_t>(1, 256 / std::max<uint32_t>(n0, 1));
+        for (size_t i = 0; i < runs.size(); i += perCall)
+            ctx.sampler.traceMany(runs.data() + i, std::min(perCall, runs.size() - i), false);
+        for (const auto& run : runs) {
+            const size_t p = size_t(y) * W + run.x;
+            for (uint32_t k = 0; k < n0; ++k) {
+                rays += run.out[k].rays;
+                records[offset[p] + k] = filter::MaafSample::pack(run.out[k].record, view, stats[p].slotOf(run.out[k]));
             }
         }
         retracedRays += rays;

@@ -1,6 +1,7 @@
 #include "render/path_sampler.h"
 
 #include <algorithm>
+#include <memory>
 
 namespace wedge::render {
 
@@ -169,149 +170,205 @@ void PathSampler::cameraRays(const PixelSampler& rng, int x, int y, uint32_t fir
     }
 }
 
+/// A wave of samples traced together (PathSampler::traceMany): up to kLanes samples of
+/// several pixels, 16 at a time through the camera (one pixel's batch: a coherent packet), and
+/// then each of the other three kinds of ray (shadow, bounce, the bounce's shadow) as one
+/// Embree stream. Kept per thread and reused.
+struct PathSampler::Wave {
+    static constexpr int kLanes = 256;
+    TracedSample* out[kLanes];
+    float time[kLanes], choice[kLanes];
+    Vec3f normal[kLanes], geometric[kLanes];  // shading and geometric normals, on the side the ray came from
+    Vec2f uLight[kLanes], uBounce[kLanes], uBounceLight[kLanes];
+    LightSample ls[kLanes], l2[kLanes];
+    scene::Hit hit[kLanes];
+    bool found[kLanes];
+    // The bounce rays (a stream), the lane of each, their hits and light samples.
+    scene::RaySegment bounce[kLanes];
+    uint16_t bounceLane[kLanes];
+    scene::Hit h2[kLanes];
+    bool found2[kLanes];
+    // A stream of shadow rays and the lane (or the bounce) each belongs to.
+    scene::RaySegment rays[kLanes];
+    uint16_t lane[kLanes];
+    bool occluded[kLanes];
+    scene::OccluderSpan spans[kLanes];
+    int nRays = 0;
+    void push(int l, const Vec3f& org, const Vec3f& dir, float tFar, float t) {
+        rays[nRays] = {org, dir, tFar, t};
+        lane[nRays++] = uint16_t(l);
+    }
+};
+
 void PathSampler::traceBatch(int x, int y, uint32_t first, uint32_t count, bool span, TracedSample* outs) const {
+    const SampleRun run{x, y, first, count, outs};
+    traceMany(&run, 1, span);
+}
+
+void PathSampler::traceMany(const SampleRun* runs, size_t nRuns, bool span) const {
     constexpr int K = scene::RayPacket::kSize;
-    const PixelSampler rng(m_seed, uint32_t(y) * uint32_t(m_camera.width()) + uint32_t(x));
-    for (uint32_t base = 0; base < count; base += K) {
-        const int n = int(std::min<uint32_t>(K, count - base));
-        TracedSample* out = outs + base;
-        float time[K], choice[K];
-        const scene::Material* mat[K] = {};
-        Vec3f normal[K], geometric[K];  // shading and geometric normals, on the side the ray came from
-        LightSample ls[K], l2[K];
-
-        // The batch's random numbers, pair by pair (vectorised across samples). Dimensions that
-        // do not matter are not drawn (the others do not depend on it).
-        const uint32_t first16 = first + base;
-        Vec2f uLight[K], uBounce[K], uBounceLight[K];
-        if (m_indirect) {
-            rng.get2DBatch(first16, uint32_t(n), kBounce, uBounce);
-            rng.get2DBatch(first16, uint32_t(n), kBounceLight, uBounceLight);
-        }
-
-        // Primary rays through the lens.
-        scene::RayPacket primary;
-        Vec2f lens[K], film[K];
-        cameraRays(rng, x, y, first16, n, primary, lens, choice, time, uLight, film);
-        for (int k = 0; k < n; ++k) {
-            out[k] = TracedSample();
-            out[k].record.lens = lens[k];
-            out[k].film = film[k];
-            out[k].time = time[k];
-            out[k].rays = 1;
-        }
-        scene::Hit hit[K];
-        bool found[K] = {};
-        m_scene.intersect(primary, hit, found, true);
-
-        // Direct light at the primary hits: one light sample and shadow ray each.
-        scene::RayPacket shadow;
-        for (int k = 0; k < n; ++k) {
-            if (!found[k]) continue;
-            mat[k] = &m_scene.material(hit[k].material);
-            bool front = dot(hit[k].normal, primary.dir[k]) < 0;
-            geometric[k] = front ? hit[k].normal : -hit[k].normal;  // two-sided shading
-            normal[k] = facing(hit[k].shadingNormal, geometric[k]);
-            TracedSample& o = out[k];
-            o.hit = true;
-            o.albedo = hit[k].albedo;
-            o.normal = normal[k];
-            o.position = hit[k].position;
-            o.depth = m_camera.depth(hit[k].position);
-            o.object = hit[k].object;
-            if (lengthSquared(hit[k].displacement) > 0) {
-                // The hit point's path over the shutter, through the lens centre.
-                const Vec3f& d = hit[k].displacement;
-                const Vec2f open = m_camera.project(hit[k].position - d * time[k]);
-                const Vec2f close = m_camera.project(hit[k].position + d * (1.f - time[k]));
-                o.motion = {close.x - open.x, close.y - open.y};
-            }
-            if (front) o.emission = mat[k]->emission;  // emitters shine from their front side
-            ls[k] = sampleLight(hit[k].position, normal[k], uLight[k], choice[k]);
-            o.record.light = m_group[ls[k].light];
-            o.record.lightPoint = ls[k].point;
-            if (maxComponent(ls[k].irradiance) <= 0) continue;
-            o.record.unoccluded = luminance(ls[k].irradiance) * kInvPi;
-            o.shadowTested = true;
-            o.d1 = length(m_groupCenter[o.record.light] - hit[k].position);
-            if (dot(ls[k].toLight, geometric[k]) <= 0) {
-                // Above the shading normal's horizon, below the facet's: the surface shadows
-                // itself (no occluder to take a slope from).
-                o.occluded = o.selfShadowed = true;
+    thread_local std::unique_ptr<Wave> scratch;
+    if (!scratch) scratch = std::make_unique<Wave>();
+    Wave& w = *scratch;
+    size_t r = 0;
+    uint32_t done = 0;  // samples of runs[r] already traced
+    uint64_t bad = 0;
+    while (r < nRuns) {
+        // Camera rays and primary hits, one pixel's batch of up to 16 at a time, and each hit's
+        // light sample, until the wave is full.
+        int lanes = 0;
+        w.nRays = 0;
+        while (r < nRuns && lanes + K <= Wave::kLanes) {
+            const SampleRun& run = runs[r];
+            if (done >= run.count) {
+                ++r;
+                done = 0;
                 continue;
             }
-            Vec3f org = offset(hit[k].position, geometric[k]);
-            Vec3f toPoint = ls[k].point - org;
-            float dist = length(toPoint);
-            shadow.set(k, org, toPoint / dist, dist * (1.f - 1e-4f), time[k]);
-            ++o.rays;
-        }
-        if (shadow.any()) {
-            if (span) {
-                scene::OccluderSpan spans[K];
-                m_scene.occluders(shadow, spans);
-                for (int k = 0; k < n; ++k) {
-                    if (!shadow.valid[k]) continue;
-                    out[k].occluded = spans[k].occluded;
-                    out[k].tNear = spans[k].tNear;
-                    out[k].tFar = spans[k].tFar;
-                }
-            } else {
-                bool occ[K];
-                m_scene.occluded(shadow, occ);
-                for (int k = 0; k < n; ++k)
-                    if (shadow.valid[k]) out[k].occluded = occ[k];
+            const int n = int(std::min<uint32_t>(K, run.count - done));
+            const uint32_t first = run.first + done;
+            TracedSample* out = run.out + done;
+            done += uint32_t(n);
+            const int l0 = lanes;
+            lanes += n;
+
+            // The batch's random numbers, pair by pair (vectorised across samples). Dimensions
+            // that do not matter are not drawn (the others do not depend on it).
+            const PixelSampler rng(m_seed, uint32_t(run.y) * uint32_t(m_camera.width()) + uint32_t(run.x));
+            if (m_indirect) {
+                rng.get2DBatch(first, uint32_t(n), kBounce, w.uBounce + l0);
+                rng.get2DBatch(first, uint32_t(n), kBounceLight, w.uBounceLight + l0);
             }
-            for (int k = 0; k < n; ++k)
-                if (shadow.valid[k] && !out[k].occluded) out[k].record.direct = ls[k].irradiance * kInvPi;
-        }
-        if (!m_indirect) continue;
 
-        // One cosine-weighted bounce per sample.
-        scene::RayPacket bounce;
-        for (int k = 0; k < n; ++k) {
-            if (!found[k] || maxComponent(hit[k].albedo) <= 0) continue;
-            Vec3f dir = Frame(normal[k]).toWorld(cosineHemisphere(uBounce[k].x, uBounce[k].y));
-            if (dot(dir, geometric[k]) <= 0) continue;  // into the facet: no light comes that way
-            out[k].record.bounceDir = dir;
-            bounce.set(k, offset(hit[k].position, geometric[k]), dir, kInf, time[k]);
-            ++out[k].rays;
-        }
-        if (!bounce.any()) continue;
-        scene::Hit h2[K];
-        bool found2[K] = {};
-        m_scene.intersect(bounce, h2, found2, false);
+            // Primary rays through the lens.
+            scene::RayPacket primary;
+            Vec2f lens[K], film[K];
+            cameraRays(rng, run.x, run.y, first, n, primary, lens, w.choice + l0, w.time + l0, w.uLight + l0, film);
+            for (int k = 0; k < n; ++k) {
+                w.out[l0 + k] = out + k;
+                out[k] = TracedSample();
+                out[k].record.lens = lens[k];
+                out[k].film = film[k];
+                out[k].time = w.time[l0 + k];
+                out[k].rays = 1;
+            }
+            if (m_log) m_log->add(scene::RayLog::kPrimary, primary);
+            m_scene.intersect(primary, w.hit + l0, w.found + l0, true);
 
-        // The bounce hit lit by its own light sample.
-        scene::RayPacket shadow2;
-        for (int k = 0; k < n; ++k) {
-            if (!found2[k]) continue;
-            out[k].bounceHit = true;
-            out[k].bounceDistance = h2[k].t;
-            if (maxComponent(h2[k].albedo) <= 0) continue;
-            Vec3f g2 = dot(h2[k].normal, bounce.dir[k]) < 0 ? h2[k].normal : -h2[k].normal;
-            l2[k] = sampleLight(h2[k].position, facing(h2[k].shadingNormal, g2), uBounceLight[k], choice[k]);
-            if (maxComponent(l2[k].irradiance) <= 0 || dot(l2[k].toLight, g2) <= 0) continue;
-            Vec3f org2 = offset(h2[k].position, g2);
-            Vec3f toPoint = l2[k].point - org2;
-            float dist = length(toPoint);
-            shadow2.set(k, org2, toPoint / dist, dist * (1.f - 1e-4f), time[k]);
-            ++out[k].rays;
+            // Direct light at the primary hits: one light sample each, its shadow ray queued.
+            for (int k = 0; k < n; ++k) {
+                const int l = l0 + k;
+                if (!w.found[l]) continue;
+                const scene::Hit& hit = w.hit[l];
+                const scene::Material& mat = m_scene.material(hit.material);
+                const bool front = dot(hit.normal, primary.dir[k]) < 0;
+                w.geometric[l] = front ? hit.normal : -hit.normal;  // two-sided shading
+                w.normal[l] = facing(hit.shadingNormal, w.geometric[l]);
+                TracedSample& o = out[k];
+                o.hit = true;
+                o.albedo = hit.albedo;
+                o.normal = w.normal[l];
+                o.position = hit.position;
+                o.depth = m_camera.depth(hit.position);
+                o.object = hit.object;
+                if (lengthSquared(hit.displacement) > 0) {
+                    // The hit point's path over the shutter, through the lens centre.
+                    const Vec3f& d = hit.displacement;
+                    const Vec2f open = m_camera.project(hit.position - d * w.time[l]);
+                    const Vec2f close = m_camera.project(hit.position + d * (1.f - w.time[l]));
+                    o.motion = {close.x - open.x, close.y - open.y};
+                }
+                if (front) o.emission = mat.emission;  // emitters shine from their front side
+                const LightSample& ls = w.ls[l] = sampleLight(hit.position, w.normal[l], w.uLight[l], w.choice[l]);
+                o.record.light = m_group[ls.light];
+                o.record.lightPoint = ls.point;
+                if (maxComponent(ls.irradiance) <= 0) continue;
+                o.record.unoccluded = luminance(ls.irradiance) * kInvPi;
+                o.shadowTested = true;
+                o.d1 = length(m_groupCenter[o.record.light] - hit.position);
+                if (dot(ls.toLight, w.geometric[l]) <= 0) {
+                    // Above the shading normal's horizon, below the facet's: the surface shadows
+                    // itself (no occluder to take a slope from).
+                    o.occluded = o.selfShadowed = true;
+                    continue;
+                }
+                const Vec3f org = offset(hit.position, w.geometric[l]);
+                const Vec3f toPoint = ls.point - org;
+                const float dist = length(toPoint);
+                w.push(l, org, toPoint / dist, dist * (1.f - 1e-4f), w.time[l]);
+                ++o.rays;
+            }
         }
-        if (!shadow2.any()) continue;
-        bool occ2[K];
-        m_scene.occluded(shadow2, occ2);
-        for (int k = 0; k < n; ++k)
-            if (shadow2.valid[k] && !occ2[k])
+        if (lanes == 0) break;
+
+        // The wave's shadow rays as one stream.
+        if (m_log) m_log->add(scene::RayLog::kShadow, w.rays, size_t(w.nRays));
+        if (span) {
+            m_scene.occluders(w.rays, size_t(w.nRays), w.spans);
+            for (int j = 0; j < w.nRays; ++j) {
+                TracedSample& o = *w.out[w.lane[j]];
+                o.occluded = w.spans[j].occluded;
+                o.tNear = w.spans[j].tNear;
+                o.tFar = w.spans[j].tFar;
+            }
+        } else {
+            m_scene.occluded(w.rays, size_t(w.nRays), w.occluded);
+            for (int j = 0; j < w.nRays; ++j) w.out[w.lane[j]]->occluded = w.occluded[j];
+        }
+        for (int j = 0; j < w.nRays; ++j) {
+            TracedSample& o = *w.out[w.lane[j]];
+            if (!o.occluded) o.record.direct = w.ls[w.lane[j]].irradiance * kInvPi;
+        }
+        if (m_indirect) {
+            // One cosine-weighted bounce per sample, the wave's as one stream (incoherent rays:
+            // as fast as one by one in Embree, bench/embree_ceiling.cpp, and their hits' data is
+            // then fetched together), each hit lit by its own light sample.
+            int nBounce = 0;
+            for (int l = 0; l < lanes; ++l) {
+                if (!w.found[l] || maxComponent(w.hit[l].albedo) <= 0) continue;
+                const Vec3f dir = Frame(w.normal[l]).toWorld(cosineHemisphere(w.uBounce[l].x, w.uBounce[l].y));
+                if (dot(dir, w.geometric[l]) <= 0) continue;  // into the facet: no light comes that way
+                w.out[l]->record.bounceDir = dir;
+                ++w.out[l]->rays;
+                w.bounce[nBounce] = {offset(w.hit[l].position, w.geometric[l]), dir, kInf, w.time[l]};
+                w.bounceLane[nBounce++] = uint16_t(l);
+            }
+            if (m_log) m_log->add(scene::RayLog::kBounce, w.bounce, size_t(nBounce));
+            m_scene.intersect(w.bounce, size_t(nBounce), w.h2, w.found2);
+            w.nRays = 0;
+            for (int j = 0; j < nBounce; ++j) {
+                if (!w.found2[j]) continue;
+                const int l = w.bounceLane[j];
+                const scene::Hit& h2 = w.h2[j];
+                TracedSample& o = *w.out[l];
+                o.bounceHit = true;
+                o.bounceDistance = h2.t;
+                if (maxComponent(h2.albedo) <= 0) continue;
+                const Vec3f g2 = dot(h2.normal, w.bounce[j].dir) < 0 ? h2.normal : -h2.normal;
+                const LightSample& l2 = w.l2[j] =
+                    sampleLight(h2.position, facing(h2.shadingNormal, g2), w.uBounceLight[l], w.choice[l]);
+                if (maxComponent(l2.irradiance) <= 0 || dot(l2.toLight, g2) <= 0) continue;
+                const Vec3f org2 = offset(h2.position, g2);
+                const Vec3f toPoint = l2.point - org2;
+                const float dist = length(toPoint);
+                w.push(j, org2, toPoint / dist, dist * (1.f - 1e-4f), w.time[l]);
+                ++o.rays;
+            }
+            if (m_log) m_log->add(scene::RayLog::kBounceShadow, w.rays, size_t(w.nRays));
+            m_scene.occluded(w.rays, size_t(w.nRays), w.occluded);
+            for (int i = 0; i < w.nRays; ++i) {
+                if (w.occluded[i]) continue;
+                const int j = w.lane[i];  // the bounce
                 // Cosine-weighted bounce: (albedo/pi) L cos / (cos/pi) = albedo L, so the
                 // demodulated indirect is the incident radiance L = albedo2 E2 / pi.
-                out[k].record.indirect = h2[k].albedo * l2[k].irradiance * kInvPi;
-    }
-    uint64_t bad = 0;
-    for (uint32_t i = 0; i < count; ++i) {
-        const TracedSample& o = outs[i];
-        bad += !(isFinite(o.emission) && isFinite(o.record.direct) && isFinite(o.record.indirect) &&
-                 std::isfinite(o.record.unoccluded));
+                w.out[w.bounceLane[j]]->record.indirect = w.h2[j].albedo * w.l2[j].irradiance * kInvPi;
+            }
+        }
+        for (int l = 0; l < lanes; ++l) {
+            const TracedSample& o = *w.out[l];
+            bad += !(isFinite(o.emission) && isFinite(o.record.direct) && isFinite(o.record.indirect) &&
+                     std::isfinite(o.record.unoccluded));
+        }
     }
     if (bad > 0) m_nonFinite.fetch_add(bad, std::memory_order_relaxed);
 }

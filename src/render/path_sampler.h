@@ -61,6 +61,16 @@ public:
     /// time as Embree ray packets (a pixel's primary and shadow rays are coherent). The same
     /// samples as trace() one by one.
     void traceBatch(int x, int y, uint32_t first, uint32_t count, bool span, TracedSample* out) const;
+    /// Samples first .. first+count-1 of pixel (x, y), into out[0..count): one of traceMany's runs.
+    struct SampleRun {
+        int x = 0, y = 0;
+        uint32_t first = 0, count = 0;
+        TracedSample* out = nullptr;
+    };
+    /// Traces several pixels' runs together, so that Embree sees their shadow rays as one
+    /// stream of up to 256 (faster than 16-wide packets: docs/sampling-speed.md). The same
+    /// samples as traceBatch on each run.
+    void traceMany(const SampleRun* runs, size_t n, bool span) const;
 
     /// The mean emitted radiance that the camera rays of samples 0 .. count-1 of pixel (x, y)
     /// see: the emitted part of those path samples, from their primary rays alone (no light
@@ -85,12 +95,16 @@ public:
     /// --stats reports them (nonfinite_samples) beside the pixels they reach.
     uint64_t nonFiniteSamples() const { return m_nonFinite.load(std::memory_order_relaxed); }
     const scene::Scene& scene() const { return m_scene; }
+    /// Appends every ray traceBatch asks Embree for to `log` (null: none), by kind. One thread
+    /// only: for the throughput benchmark, never in a render.
+    void logRays(scene::RayLog* log) { m_log = log; }
     ViewGeometry view() const;
     /// The lights' closed-form irradiance at x (normal n), without occlusion
     /// (scene::LightIrradiance, built once with the sampler's light groups).
     Vec3f unoccludedIrradiance(const Vec3f& x, const Vec3f& n) const { return m_irradiance(x, n); }
 
 private:
+    struct Wave;
     struct LightSample {
         Vec3f point;
         Vec3f irradiance;  // E: radiance * cos * cos / r^2 / pdf, zero if facing away
@@ -122,6 +136,7 @@ private:
     std::vector<Vec3f> m_groupCenter;  // each group's centroid
     std::vector<float> m_groupArea;
     scene::LightIrradiance m_irradiance;
+    scene::RayLog* m_log = nullptr;
     const Distribution* m_distribution = nullptr;
     int m_rank = 0, m_ranks = 1;
 };

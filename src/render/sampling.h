@@ -58,24 +58,42 @@ uint64_t samplePixels(const PathSampler& sampler, PixelStatsImage& stats, const 
     SlotPool& pool = stats.pool();
     parallelTiles(stats.width(), stats.height(), 16, [&](int x0, int x1, int y0, int y1) {
         uint64_t localRays = 0, localSamples = 0;
+        // Several pixels' samples are traced together (PathSampler::traceMany: their shadow rays
+        // as one Embree stream), then added pixel by pixel, each pixel's in order.
+        std::vector<PathSampler::SampleRun> runs;
+        std::vector<TracedSample> traced;
+        uint32_t queued = 0;
+        auto flush = [&] {
+            traced.resize(std::max<size_t>(traced.size(), queued));
+            uint32_t offset = 0;
+            for (auto& run : runs) {
+                run.out = traced.data() + offset;
+                offset += run.count;
+            }
+            sampler.traceMany(runs.data(), runs.size(), span);
+            for (const auto& run : runs) {
+                PixelStats& ps = stats(run.x, run.y);
+                for (uint32_t k = 0; k < run.count; ++k) {
+                    int slot = ps.add(run.out[k], view, slopes, pool);
+                    sink(run.x, run.y, run.out[k], slot);
+                    localRays += run.out[k].rays;
+                }
+            }
+            runs.clear();
+            queued = 0;
+        };
         for (int y = y0; y < y1; ++y) {
             if (!sampler.tracesRow(y)) continue;
             for (int x = x0; x < x1; ++x) {
                 SampleRange r = range(x, y);
-                PixelStats& ps = stats(x, y);
-                TracedSample batch[16];
-                for (uint32_t i = 0; i < r.count; i += 16) {
-                    uint32_t n = std::min<uint32_t>(16, r.count - i);
-                    sampler.traceBatch(x, y, r.first + i, n, span, batch);
-                    for (uint32_t k = 0; k < n; ++k) {
-                        int slot = ps.add(batch[k], view, slopes, pool);
-                        sink(x, y, batch[k], slot);
-                        localRays += batch[k].rays;
-                    }
-                }
                 localSamples += r.count;
+                if (r.count == 0) continue;
+                runs.push_back({x, y, r.first, r.count, nullptr});
+                queued += r.count;
+                if (queued >= 256) flush();
             }
         }
+        if (!runs.empty()) flush();
         rays += localRays;
         if (progress) progress->add(localSamples * uint64_t(sampler.ranks()));  // rank 0's share, scaled
     });

@@ -1,5 +1,6 @@
 #include "scene/scene.h"
 
+#include <algorithm>
 #include <cstdio>
 #include <cstring>
 #include <string>
@@ -69,7 +70,6 @@ Scene::Scene(SceneDesc desc) : m_desc(std::move(desc)) {
     if (!m_device) throw Error("Embree: cannot create a device (error " + std::to_string(int(rtcGetDeviceError(nullptr))) + ")");
     rtcSetDeviceErrorFunction(m_device, embreeError, nullptr);  // right after creation, as Embree's tutorials do
     m_scene = rtcNewScene(m_device);
-    rtcSetSceneFlags(m_scene, RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION);
     rtcSetSceneBuildQuality(m_scene, RTC_BUILD_QUALITY_HIGH);
 
     // Time step 0 at shutter open, 1 at close (rays carry the normalised shutter time); an
@@ -200,6 +200,10 @@ void Scene::intersect(const RayPacket& rays, Hit hits[RayPacket::kSize], bool fo
     }
     alignas(64) RTCRayHit16 rh;
     closestHits(m_scene, rays, rays.valid, rh, true);
+    // A hit's per-primitive data (corner normals, material, uv) is a cache miss on a large
+    // mesh: requested for all lanes first, so that the misses overlap.
+    for (int i = 0; i < RayPacket::kSize; ++i)
+        if (rays.valid[i] && rh.hit.geomID[i] != RTC_INVALID_GEOMETRY_ID) prefetchHit(rh.hit.geomID[i], rh.hit.primID[i]);
     for (int i = 0; i < RayPacket::kSize; ++i) {
         found[i] = rays.valid[i] && rh.hit.geomID[i] != RTC_INVALID_GEOMETRY_ID;
         if (found[i])
@@ -246,6 +250,79 @@ void Scene::occluders(const RayPacket& rays, OccluderSpan spans[RayPacket::kSize
     for (int i = 0; i < RayPacket::kSize; ++i)
         if (back[i] && rh.hit.geomID[i] != RTC_INVALID_GEOMETRY_ID)
             spans[i].tFar = std::max(spans[i].tNear, rays.tFar[i] - rh.ray.tfar[i]);
+}
+
+namespace {
+
+/// Scratch for the stream queries, one per thread (a stream is at most a few hundred rays).
+std::vector<RTCRayHit>& streamScratch(size_t n) {
+    thread_local std::vector<RTCRayHit> scratch;
+    if (scratch.size() < n) scratch.resize(n);
+    return scratch;
+}
+
+}  // namespace
+
+void Scene::prefetchHit(unsigned geomID, unsigned primID) const {
+    const GeometryInfo& g = m_geometry[geomID];
+    if (g.cornerNormals) __builtin_prefetch(g.cornerNormals + 3 * size_t(primID));
+    if (g.materialIds) __builtin_prefetch(g.materialIds + primID);
+    if (g.cornerUVs) __builtin_prefetch(g.cornerUVs + 3 * size_t(primID));
+}
+
+void Scene::intersect(const RaySegment* rays, size_t n, Hit* hits, bool* found) const {
+    if (n == 0) return;
+    std::vector<RTCRayHit>& rh = streamScratch(n);
+    for (size_t i = 0; i < n; ++i) rh[i] = makeRayHit(rays[i].org, rays[i].dir, 0.f, rays[i].tFar, rays[i].time);
+    RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);  // incoherent
+    rtcIntersect1M(m_scene, &ctx, rh.data(), unsigned(n), sizeof(RTCRayHit));
+    for (size_t i = 0; i < n; ++i)
+        if (rh[i].hit.geomID != RTC_INVALID_GEOMETRY_ID) prefetchHit(rh[i].hit.geomID, rh[i].hit.primID);
+    for (size_t i = 0; i < n; ++i) {
+        found[i] = rh[i].hit.geomID != RTC_INVALID_GEOMETRY_ID;
+        if (found[i])
+            fillHit(rays[i].org, rays[i].dir, rh[i].ray.tfar, rays[i].time, rh[i].hit.geomID, rh[i].hit.primID,
+                    Vec3f(rh[i].hit.Ng_x, rh[i].hit.Ng_y, rh[i].hit.Ng_z), rh[i].hit.u, rh[i].hit.v, hits[i]);
+    }
+}
+
+void Scene::occluded(const RaySegment* rays, size_t n, bool* occluded) const {
+    if (n == 0) return;
+    std::vector<RTCRayHit>& rh = streamScratch(n);
+    for (size_t i = 0; i < n; ++i) rh[i].ray = makeRayHit(rays[i].org, rays[i].dir, 0.f, rays[i].tFar, rays[i].time).ray;
+    RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);  // incoherent
+    rtcOccluded1M(m_scene, &ctx, &rh[0].ray, unsigned(n), sizeof(RTCRayHit));
+    for (size_t i = 0; i < n; ++i) occluded[i] = rh[i].ray.tfar < 0;
+}
+
+void Scene::occluders(const RaySegment* rays, size_t n, OccluderSpan* spans) const {
+    // As the packet query: the nearest occluder from the receiver, then, for the rays that found
+    // one, the nearest seen from the far end looking back (the farthest from the receiver).
+    if (n == 0) return;
+    std::vector<RTCRayHit>& rh = streamScratch(n);
+    for (size_t i = 0; i < n; ++i) rh[i] = makeRayHit(rays[i].org, rays[i].dir, 0.f, rays[i].tFar, rays[i].time);
+    RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    rtcIntersect1M(m_scene, &ctx, rh.data(), unsigned(n), sizeof(RTCRayHit));
+    size_t back = 0;
+    for (size_t i = 0; i < n; ++i) {
+        const bool hit = rh[i].hit.geomID != RTC_INVALID_GEOMETRY_ID;
+        spans[i] = hit ? OccluderSpan{true, rh[i].ray.tfar, rh[i].ray.tfar} : OccluderSpan{};
+        if (!hit) continue;
+        float len = rays[i].tFar, slack = 1e-4f * len;
+        rh[back] = makeRayHit(rays[i].org + rays[i].dir * len, -rays[i].dir, 0.f, len - spans[i].tNear + slack, rays[i].time);
+        rh[back].ray.id = unsigned(i);
+        ++back;
+    }
+    if (back == 0) return;
+    rtcIntersect1M(m_scene, &ctx, rh.data(), unsigned(back), sizeof(RTCRayHit));
+    for (size_t j = 0; j < back; ++j) {
+        const unsigned i = rh[j].ray.id;
+        if (rh[j].hit.geomID != RTC_INVALID_GEOMETRY_ID)
+            spans[i].tFar = std::max(spans[i].tNear, rays[i].tFar - rh[j].ray.tfar);
+    }
 }
 
 bool Scene::occluded(const Vec3f& org, const Vec3f& dir, float tNear, float tFar, float time) const {

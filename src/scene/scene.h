@@ -51,6 +51,26 @@ struct RayPacket {
     }
 };
 
+/// A ray from its origin to tFar along a unit direction, at a shutter time: one element of a
+/// ray stream (Scene's stream queries).
+struct RaySegment {
+    Vec3f org, dir;
+    float tFar = 0, time = 0;
+};
+
+/// The rays of a render as Embree was asked to trace them, by kind: what the throughput
+/// benchmark (bench/embree_ceiling.cpp) traces again with Embree alone, to measure how fast the
+/// sampling stage could be. Filled by PathSampler::logRays (one thread).
+struct RayLog {
+    enum Kind { kPrimary, kShadow, kBounce, kBounceShadow, kKinds };
+    std::vector<RaySegment> rays[kKinds];
+    void add(Kind kind, const RayPacket& p) {
+        for (int i = 0; i < RayPacket::kSize; ++i)
+            if (p.valid[i]) rays[kind].push_back({p.org[i], p.dir[i], p.tFar[i], p.time[i]});
+    }
+    void add(Kind kind, const RaySegment* r, size_t n) { rays[kind].insert(rays[kind].end(), r, r + n); }
+};
+
 class Scene {
 public:
     explicit Scene(SceneDesc desc);
@@ -75,8 +95,19 @@ public:
     void intersect(const RayPacket& rays, Hit hits[RayPacket::kSize], bool found[RayPacket::kSize], bool coherent) const;
     void occluded(const RayPacket& rays, bool occluded[RayPacket::kSize]) const;
     void occluders(const RayPacket& rays, OccluderSpan spans[RayPacket::kSize]) const;
+    /// The same queries over a stream of n rays (Embree's rtcOccluded1M / rtcIntersect1M). On
+    /// Sponza's shadow rays a stream of 256 (16 pixels' samples) is 1.2-1.4x as fast as the
+    /// pixels' 16-wide packets (bench/embree_ceiling.cpp, docs/sampling-speed.md).
+    void occluded(const RaySegment* rays, size_t n, bool* occluded) const;
+    /// Closest hits of a stream (found[i] false where none).
+    void intersect(const RaySegment* rays, size_t n, Hit* hits, bool* found) const;
+    void occluders(const RaySegment* rays, size_t n, OccluderSpan* spans) const;
+    /// The Embree scene itself (benchmarks trace against it directly).
+    RTCScene embree() const { return m_scene; }
 
 private:
+    /// Asks the memory for what fillHit will read of a primitive.
+    void prefetchHit(unsigned geomID, unsigned primID) const;
     /// `time`: the ray's, normalised over the shutter (0 at open, 1 at close).
     void fillHit(const Vec3f& org, const Vec3f& dir, float t, float time, unsigned geomID, unsigned primID,
                  const Vec3f& ng, float u, float v, Hit& hit) const;
