@@ -143,12 +143,12 @@ void BM_EmbreeAlone(benchmark::State& state) {
 }
 BENCHMARK(BM_EmbreeAlone)->ArgsProduct({{0, 1, 2, 3}, {0, 1, 2}})->Unit(benchmark::kMillisecond)->MinTime(1.0);
 
-/// All kinds together: arg 0 the sampler's modes (primary rays in packets, shadow rays in
-/// streams, bounces one by one), arg 1 each
+/// All kinds together: arg 0 the sampler's modes (primary rays in one pixel's packets, the
+/// others in streams of up to 256), arg 1 each
 /// kind in its fastest mode, chosen by timing each (fastest of three passes) before the run.
 void BM_EmbreeCeiling(benchmark::State& state) {
     const Recorded& r = recorded();
-    Mode modes[scene::RayLog::kKinds] = {Mode::kPacket, Mode::kStream, Mode::kSingle, Mode::kStream};
+    Mode modes[scene::RayLog::kKinds] = {Mode::kPacket, Mode::kStream, Mode::kStream, Mode::kStream};
     std::string label = "wedge's modes";
     if (state.range(0) == 1) {
         label = "fastest:";

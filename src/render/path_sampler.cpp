@@ -21,6 +21,8 @@ PathSampler::PathSampler(const scene::Scene& scene, const Camera& camera, bool i
     for (const auto& l : scene.desc().lights) {
         total += std::max(1e-12f, luminance(l.radiance) * l.area());
         m_lightCdf.push_back(total);
+        m_lightNormal.push_back(l.sphere() ? Vec3f(0.f) : l.normal());
+        m_lightArea.push_back(l.area());
     }
     for (float& c : m_lightCdf) c /= total;
     // The lights the filters see (scene::lightGroups) and their centroids.
@@ -89,12 +91,12 @@ PathSampler::LightSample PathSampler::sampleLight(const Vec3f& p, const Vec3f& n
     s.distance = length(w);
     s.toLight = w / s.distance;
     float cosX = dot(n, s.toLight);
-    float cosY = -dot(light.normal(), s.toLight);  // emits only from the front side
+    float cosY = -dot(m_lightNormal[li], s.toLight);  // emits only from the front side
     if (cosX <= 0 || cosY <= 0 || s.distance <= 0) {
         s.irradiance = Vec3f(0.f);
     } else {
         // Uniform area sampling: pdf = 1 / (area * pChoice).
-        s.irradiance = light.radiance * (cosX * cosY / (s.distance * s.distance) * light.area() / pChoice);
+        s.irradiance = light.radiance * (cosX * cosY / (s.distance * s.distance) * m_lightArea[li] / pChoice);
     }
     return s;
 }

@@ -132,6 +132,8 @@ private:
     bool m_needChoice;  // light choice or shutter time vary
     mutable std::atomic<uint64_t> m_nonFinite{0};
     std::vector<float> m_lightCdf;     // light choice proportional to power
+    std::vector<Vec3f> m_lightNormal;  // each light's normal() and area(), once (sampleLight's hot loop)
+    std::vector<float> m_lightArea;
     std::vector<uint32_t> m_group;     // scene light -> its group, the ViewGeometry light (scene::lightGroups)
     std::vector<Vec3f> m_groupCenter;  // each group's centroid
     std::vector<float> m_groupArea;
