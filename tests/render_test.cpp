@@ -541,6 +541,36 @@ TEST(Render, MaafTracingAgainGivesTheImageOfTheRecords) {
     EXPECT_EQ(0, std::memcmp(kept.color.data(), traced.color.data(), kept.color.size() * sizeof(Vec3f)));
 }
 
+TEST(Render, MaafIsAafWhereNoFilterHasOuterComponents) {
+    // By default MAAF runs AAF's pipeline (slopes, rates, filter) and MAAF's filter only where an
+    // effect has outer components: with the central component alone (--maaf-components 1) the
+    // image and the samples are AAF's bit for bit (a lens, a shadow and indirect light here).
+    scene::Scene s(parse(kPlankUnderLens));
+    render::RenderOptions o;
+    o.quiet = true;
+    o.method = "aaf";
+    render::RenderResult aaf = render::render(s, o);
+    o.method = "maaf";
+    o.maafComponents = 1;
+    render::RenderResult central = render::render(s, o);
+    EXPECT_EQ(central.figure("maaf_outer_component_pixels").value_or(-1), 0.0);
+    EXPECT_EQ(central.rays, aaf.rays);
+    EXPECT_EQ(central.sppAverage, aaf.sppAverage);
+    ASSERT_EQ(central.color.size(), aaf.color.size());
+    EXPECT_EQ(0, std::memcmp(central.color.data(), aaf.color.data(), aaf.color.size() * sizeof(Vec3f)));
+
+    // With outer components (all of them everywhere, so that most pixels use them) the samples
+    // are still AAF's; only the pixels' filters differ, and the outer pixels' initial samples
+    // are traced again.
+    o.maafComponents = 5;
+    o.maafFit = false;
+    render::RenderResult outer = render::render(s, o);
+    EXPECT_GT(outer.figure("maaf_outer_component_pixels").value_or(-1), 0.5 * 32 * 32);
+    EXPECT_EQ(outer.sppAverage, aaf.sppAverage);
+    EXPECT_GT(outer.rays, aaf.rays);
+    EXPECT_NE(0, std::memcmp(outer.color.data(), aaf.color.data(), aaf.color.size() * sizeof(Vec3f)));
+}
+
 namespace {
 /// A path sample on surface `object` at depth 1 with the given direct light (albedo 1).
 render::TracedSample surfaceSample(uint32_t object, float light) {

@@ -41,6 +41,15 @@ struct AafOptions {
     float zMinPixels = 10.f;  // clamp of the bounce distance z_min, in pixel sizes (NOTES: scene-scale constant)
 };
 
+/// AAF's slope prefilter: a pixel keeps its own slopes and those without take them from a
+/// 10-px window (NOTES, AAF 2012 code).
+inline WedgeOptions aafWedgeOptions() {
+    WedgeOptions wo;
+    wo.radius = 5;
+    wo.fillOnly = true;
+    return wo;
+}
+
 /// Per-pixel AAF parameters.
 struct AafParams {
     Image1f omegaDirect, omegaIndirect;  // combined bandwidths, world^-1 (0: unbounded)

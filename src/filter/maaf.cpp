@@ -419,8 +419,24 @@ struct Window {
 }  // namespace
 
 Image3f MaafAccumulator::filter(const MaafEffect& params, const FrameBuffers& fb, const Image<AxisFrame>& frames,
-                                const Image3f& fallback, const MaafOptions& o) const {
+                                const Image3f& fallback, const MaafOptions& o, const Image<uint8_t>* only) const {
     const int W = m_width, H = m_height, C = m_channels, V = m_values;
+    // With `only`, pass 1 runs where pass 2 reads it: within the widest window along image y of
+    // a pixel to filter (a running count down each column).
+    LargeVector<uint8_t> needed;
+    if (only) {
+        const int reachY = std::min(o.maxRadius, kMaafMaxWindowRadius);
+        needed.resize(size_t(W) * H);
+        parallelRows(W, [&](int x) {  // (over columns)
+            int count = 0;  // pixels to filter in rows [y - reachY, y + reachY]
+            for (int y = 0; y < std::min(H, reachY); ++y) count += (*only)(x, y) != 0;
+            for (int y = 0; y < H; ++y) {
+                if (y + reachY < H) count += (*only)(x, y + reachY) != 0;
+                needed[size_t(y) * W + x] = count > 0;
+                if (y - reachY >= 0) count -= (*only)(x, y - reachY) != 0;
+            }
+        });
+    }
     // Pass 1's output at a pixel: the axis-2 bands its row neighbours accumulated, at most as many
     // as the most any pixel within the widest window has (1 in most of an image), plus the
     // central-only band. A fixed (2N-1) + 1 bands per pixel would be 38 MB at 512x512, mostly zeros.
@@ -446,7 +462,7 @@ Image3f MaafAccumulator::filter(const MaafEffect& params, const FrameBuffers& fb
     parallelRows(H, [&](int y) {
         for (int x = 0; x < W; ++x) {
             size_t p = size_t(y) * W + x;
-            if (fb.object[p] < 0) continue;
+            if (fb.object[p] < 0 || (only && !needed[p])) continue;
             const MaafAxis ax = params.filterAxis(p, 0);
             const AxisFrame& f = frames[p];
             float* out = &inter[interOffset[p]];
@@ -495,7 +511,7 @@ Image3f MaafAccumulator::filter(const MaafEffect& params, const FrameBuffers& fb
     parallelRows(H, [&](int y) {
         for (int x = 0; x < W; ++x) {
             size_t p = size_t(y) * W + x;
-            if (fb.object[p] < 0) {
+            if (fb.object[p] < 0 || (only && !(*only)[p])) {
                 result[p] = fallback[p];
                 continue;
             }

@@ -230,9 +230,11 @@ public:
     int bands(size_t p, int axis) const { return axis == 0 ? m_bands1[p] : m_bands2[p]; }
 
     /// Eq. 21 on image x then image y: the filtered values divided by the filtered weight (one
-    /// value channel is replicated to rgb). Pixels without a surface or weight keep `fallback`.
+    /// value channel is replicated to rgb). Pixels without a surface or weight keep `fallback`,
+    /// and so do those outside `only` where it is given (non-zero: filter this pixel): the first
+    /// pass then runs only where the second reads it.
     Image3f filter(const MaafEffect& params, const FrameBuffers& fb, const Image<AxisFrame>& frames,
-                   const Image3f& fallback, const MaafOptions& options) const;
+                   const Image3f& fallback, const MaafOptions& options, const Image<uint8_t>* only = nullptr) const;
 
 private:
     int m_width, m_height, m_pairs, m_values, m_channels;

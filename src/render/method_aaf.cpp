@@ -38,10 +38,7 @@ void renderAaf(const MethodContext& ctx, RenderResult& result) {
     // 2. Prefilter: fill slopes from neighbours, bandwidths and sampling rates.
     t.reset();
     filter::AafOptions ao;
-    filter::WedgeOptions wo;
-    wo.radius = 5;  // NOTES: fill empty pixels over a 10 px window
-    wo.fillOnly = true;
-    filter::WedgeField wedges = filter::prefilterWedges(fb, wo);
+    filter::WedgeField wedges = filter::prefilterWedges(fb, filter::aafWedgeOptions());
     filter::AafParams params = filter::aafParams(fb, wedges, view, ao);
     Image<uint32_t> extra(W, H);
     const Image<uint32_t> emitterExtra = emitterTopUps(stats, kEmitterEdgeSpp);

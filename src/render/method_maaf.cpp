@@ -1,17 +1,19 @@
 // --method maaf: multiple axis-aligned filters (filter/maaf.h) as in Sec. 6.2 of the paper.
 // Stages: initial sampling (16 path samples per pixel with occluder spans, folded into the
-// pixel statistics); prefilter: slopes over a 5x5 window and components per pixel; adaptive
-// sampling where the wedge degenerates at the focal plane (central filter, AAF rates) and where
-// a filter has outer components (AAF rates), and the emitter and mixed-pixel top-ups; the
-// initial samples of the pixels with outer components traced again (their adaptive samples are
-// kept when taken); then the accumulation of eq. 23
-// over each pixel's samples (the plain sums of the statistics where the pixel uses the central
-// component only); filter: eq. 21 on both image axes for direct and indirect light, then
-// multiplied by albedo; last, the defocus filter of the composited radiance (filter/defocus.h).
+// pixel statistics); prefilter: slopes over a 5x5 window and components per pixel, and AAF's
+// slopes and rates; adaptive sampling at AAF's rates in every pixel (with --maaf-paper-rates
+// only where the wedge degenerates at the focal plane, Sec. 6.2), and the emitter and
+// mixed-pixel top-ups; the initial samples of the pixels with outer components traced again
+// (their adaptive samples are kept when taken); then the accumulation of eq. 23 over each
+// pixel's samples (the plain sums of the statistics where the pixel uses the central component
+// only); filter: AAF's, then eq. 21 on both image axes for direct and indirect light where the
+// effect has outer components (with --maaf-paper-rates eq. 21 everywhere), multiplied by albedo;
+// last, the defocus filter of the composited radiance (filter/defocus.h).
 #include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <fstream>
+#include <optional>
 #include <string>
 #include <unistd.h>
 
@@ -117,9 +119,10 @@ void renderMaaf(const MethodContext& ctx, RenderResult& result) {
     storeStats(stats, ctx, fb);
     result.seconds.add("sampling_initial", t.seconds());
 
-    // 2a. Prefilter: slopes over a 5x5 window, frames, components, adaptive counts.
+    // 2a. Prefilter: slopes (AAF's; with --maaf-paper-rates over a 5x5 window, below), frames,
+    // components, adaptive counts.
     t.reset();
-    filter::WedgeOptions wo;
+    filter::WedgeOptions wo;  // the paper pipeline's slopes
     wo.radius = 2;
     wo.fillRadius = mo.maxRadius;  // lit pixels take the wedge of the shadow next to them
     // Max / min over 5x5 (robust where few samples saw an occluder, NOTES), except where at least
@@ -141,35 +144,33 @@ void renderMaaf(const MethodContext& ctx, RenderResult& result) {
     // at thresholds 0.5 / 0.6 / 0.9: cornell 0.0000959 / 0.0000959 / 0.000109, bunny 0.000148 /
     // 0.000140 / 0.000126; 1: cornell 0.000112.
     wo.ownBounceHit = 0.75f;
-    filter::WedgeField wedges = filter::prefilterWedges(fb, wo);
+    // By default AAF's pipeline runs everywhere: its slope prefilter, its sampling rates and
+    // (below) its filter, and MAAF's filter replaces AAF's only in the pixels whose fit gives
+    // outer components, so that where the central component alone would be used, MAAF costs and
+    // samples what AAF does (issue 28). --maaf-paper-rates keeps the paper's pipeline: MAAF's
+    // slopes, its central filter everywhere and adaptive samples only at the focal plane (Sec. 6.2).
+    const bool paper = ctx.options.maafPaperRates;
+    const filter::WedgeField wedges = filter::prefilterWedges(fb, paper ? wo : filter::aafWedgeOptions());
     filter::FilterFrames frames = filter::computeFrames(fb, view);
     filter::MaafParams params = filter::maafParams(fb, wedges, frames, view, mo);
-    filter::AafParams rates = filter::aafParams(fb, wedges, view, filter::AafOptions());
+    const filter::AafOptions ao;
+    const filter::AafParams rates = filter::aafParams(fb, wedges, view, ao);
     Image<uint32_t> extra(W, H);
     const Image<uint32_t> emitterExtra = emitterTopUps(stats, kEmitterEdgeSpp);
     uint64_t extraTotal = 0;
     // Whether an effect's filter at pixel p has outer components on either image axis.
     auto outerComponents = [](const filter::MaafEffect& effect, size_t p) { return effect.pairs(p, 0) > 1 || effect.pairs(p, 1) > 1; };
+    auto anyOuter = [&](const filter::MaafEffect& effect) {
+        for (size_t i = 0; i < pixels; ++i)
+            if (outerComponents(effect, i)) return true;
+        return false;
+    };
     for (size_t i = 0; i < pixels; ++i) {
-        // Sec. 6.2: extra samples where the wedge degenerates at the focal plane, at the AAF
-        // (MYRD14) rates, since there the filter is the central, axis-aligned one. Also, unless
-        // --maaf-paper-rates, wherever an effect's filter has outer components: they weigh each
-        // sample by the cos / sin of its own light, bounce and lens coordinates (eq. 23), so
-        // their estimate of the sheared spectrum is as noisy as the pixel's few samples, and
-        // those pixels (a few percent: sharp shadows, contact edges, corners) are where 16
-        // samples fall short. Measured at 512x512 against 1024-spp references (docs/maaf.md,
-        // "Adaptive samples where the outer components are"), relMSE and average spp, paper's
-        // rule -> this: cornell 0.000105 at 18.8 -> 0.0000942 at 19.6, conference 0.000659 at
-        // 22.2 -> 0.000628 at 23.5, sponza 0.000937 at 33.5 -> 0.000864 at 35.0, grids
-        // -4%, bunny -10%, cornell-sphere -8% for 4-7% more samples. (A quarter of the rate
-        // gave the same on four of the six scenes: the cap binds. AAF's rates everywhere, also
-        // where the filter is central: 24-42 spp, relMSE within -10% to +12% of AAF's, and no
-        // more efficient than this rule, 0.81-0.97x AAF against 0.78-0.99x.)
-        const bool focal = params.fallback[i] > 0, rated = !ctx.options.maafPaperRates;
-        const bool direct = focal || (rated && outerComponents(params.direct, i));
-        const bool indirect = focal || (rated && outerComponents(params.indirect, i));
-        const float need = std::max({direct ? rates.sppDirect[i] : 0.f, indirect ? rates.sppIndirect[i] : 0.f,
-                                     direct || indirect ? rates.sppLens[i] : 0.f});
+        // AAF's (MYRD14's) rates in every pixel, as --method aaf takes them. With the paper's
+        // rule (Sec. 6.2), only where the wedge degenerates at the focal plane, since there the
+        // filter is the central, axis-aligned one.
+        const bool rated = !paper || params.fallback[i] > 0;
+        const float need = rated ? std::max({rates.sppDirect[i], rates.sppIndirect[i], rates.sppLens[i]}) : 0.f;
         extra[i] = std::max(uint32_t(std::clamp(int(std::ceil(need)) - int(n0), 0, cap)),
                             std::max(emitterExtra[i], stats[i].mixedTopUp(kMixedTau, kMixedSpp)));
         extraTotal += extra[i];
@@ -252,8 +253,12 @@ void renderMaaf(const MethodContext& ctx, RenderResult& result) {
     // 2b. Accumulation of eq. 23 over the samples on each pixel's primary surface, as means:
     // the initial samples from their records (or traced again), then the adaptive ones.
     t.reset();
-    filter::MaafAccumulator accDirect(params.direct, mo.pairs, 1), accIndirect(params.indirect, mo.pairs, 3);
-    result.extra.emplace_back("maaf_accumulator_bytes", double(accDirect.allocatedBytes() + accIndirect.allocatedBytes()));
+    // An effect without outer components anywhere is AAF's alone (by default; below).
+    std::optional<filter::MaafAccumulator> accDirect, accIndirect;
+    if (paper || anyOuter(params.direct)) accDirect.emplace(params.direct, mo.pairs, 1);
+    if (paper || anyOuter(params.indirect)) accIndirect.emplace(params.indirect, mo.pairs, 3);
+    result.extra.emplace_back("maaf_accumulator_bytes", double((accDirect ? accDirect->allocatedBytes() : 0) +
+                                                               (accIndirect ? accIndirect->allocatedBytes() : 0)));
     std::atomic<uint64_t> outerPixels{0};  // pixels whose accumulation has outer components
     parallelRows(H, [&](int y) {
         uint64_t outerInRow = 0;
@@ -267,8 +272,8 @@ void renderMaaf(const MethodContext& ctx, RenderResult& result) {
                 if (slot.n > 0) {
                     const float inv = 1.f / float(slot.n), visible = slot.visible * inv;
                     const float indirectMean[3] = {slot.indirect.x * inv, slot.indirect.y * inv, slot.indirect.z * inv};
-                    accDirect.setCentral(p, &visible, slot.unoccluded * inv);
-                    accIndirect.setCentral(p, indirectMean, 1.f);
+                    if (accDirect) accDirect->setCentral(p, &visible, slot.unoccluded * inv);
+                    if (accIndirect) accIndirect->setCentral(p, indirectMean, 1.f);
                 }
                 continue;
             }
@@ -281,16 +286,16 @@ void renderMaaf(const MethodContext& ctx, RenderResult& result) {
                 float yDirect[2], yIndirect[2], u[2];
                 m.coordinates(view, frameDirect, frameIndirect, yDirect, yIndirect, u);
                 const float visibility = m.visibility();
-                accDirect.add(p, &visibility, m.unoccluded, yDirect, u, direct);
-                accIndirect.add(p, m.indirect, 1.f, yIndirect, u, indirect);
+                if (accDirect) accDirect->add(p, &visibility, m.unoccluded, yDirect, u, direct);
+                if (accIndirect) accIndirect->add(p, m.indirect, 1.f, yIndirect, u, indirect);
                 ++counted;
             };
             if (!retrace)
                 for (uint32_t i = 0; i < n0; ++i) accumulate(initial[p * n0 + i]);
             for (uint64_t i = offset[p]; i < offset[p + 1]; ++i) accumulate(records[i]);
             if (counted > 0) {
-                accDirect.scale(p, 1.f / float(counted));
-                accIndirect.scale(p, 1.f / float(counted));
+                if (accDirect) accDirect->scale(p, 1.f / float(counted));
+                if (accIndirect) accIndirect->scale(p, 1.f / float(counted));
             }
         }
         outerPixels += outerInRow;
@@ -309,11 +314,33 @@ void renderMaaf(const MethodContext& ctx, RenderResult& result) {
     t.reset();
     // Direct light as in AAF (report eq. 3.2): filtered visibility x closed-form unoccluded light.
     Timer part;
-    Image3f visibility = accDirect.filter(params.direct, fb, frames.direct, visibilityImage(fb), mo);
-    result.seconds.add("filter_direct", part.seconds());
-    part.reset();
-    Image3f indirect = accIndirect.filter(params.indirect, fb, frames.indirect, fb.indirect, mo);
-    result.seconds.add("filter_indirect", part.seconds());
+    Image3f visibility, indirect;
+    if (paper) {
+        visibility = accDirect->filter(params.direct, fb, frames.direct, visibilityImage(fb), mo);
+        result.seconds.add("filter_direct", part.seconds());
+        part.reset();
+        indirect = accIndirect->filter(params.indirect, fb, frames.indirect, fb.indirect, mo);
+        result.seconds.add("filter_indirect", part.seconds());
+    } else {
+        // AAF's filter everywhere (as --method aaf: its frames from the final buffers, its
+        // bandwidths), then MAAF's eq. 21 in the pixels whose effect has outer components.
+        const filter::FilterFrames aafFrames = filter::computeFrames(fb, view);
+        auto maafWhereOuter = [&](const std::optional<filter::MaafAccumulator>& acc, const filter::MaafEffect& effect,
+                                  const Image<filter::AxisFrame>& axes, Image3f aaf) {
+            if (!acc) return aaf;
+            Image<uint8_t> where(W, H);
+            for (size_t i = 0; i < pixels; ++i) where[i] = outerComponents(effect, i);
+            return acc->filter(effect, fb, axes, aaf, mo, &where);
+        };
+        visibility = maafWhereOuter(
+            accDirect, params.direct, frames.direct,
+            filter::aafFilter(visibilityImage(fb), rates.omegaDirect, fb, aafFrames.direct, ao, &fb.unoccluded));
+        result.seconds.add("filter_direct", part.seconds());
+        part.reset();
+        indirect = maafWhereOuter(accIndirect, params.indirect, frames.indirect,
+                                  filter::aafFilter(fb.indirect, rates.omegaIndirect, fb, aafFrames.indirect, ao));
+        result.seconds.add("filter_indirect", part.seconds());
+    }
     part.reset();
     result.color = composeFilteredLight(ctx, visibility, indirect, result);
     // Remodulation and the defocus filter; the layered reconstruction, if any, is its own stage.

@@ -29,8 +29,9 @@ struct RenderOptions {
     int maxExtraSpp = kDefaultMaxExtraSpp;
     int maafComponents = 5;          // 2N-1 filters per 2D/3D subspace
     bool maafFocalFallback = true;   // fall back to the central filter where the defocus slope changes sign
-    // Adaptive samples only at the focal plane, as Sec. 6.2 says (--maaf-paper-rates); by default
-    // the pixels whose filters have outer components take AAF's rates too (method_maaf.cpp).
+    // MAAF's pipeline as the paper has it (--maaf-paper-rates): its central filter everywhere and
+    // adaptive samples only at the focal plane (Sec. 6.2). By default AAF's rates and filter run
+    // everywhere and MAAF's filter only where it has outer components (method_maaf.cpp).
     bool maafPaperRates = false;
     bool maafWindows = false;        // eq. 20's Gaussian windows over light and lens samples
     int maafRadius = 10;             // the spatial filter's window, pixels (NOTES: the reimplementation's 10)
