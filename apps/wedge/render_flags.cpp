@@ -41,8 +41,8 @@ void addMethodFlags(CLI::App& cmd, render::RenderOptions& r) {
     cmd.add_option("--maaf-components", r.maafComponents, "maaf: filters per 2D/3D subspace (3, 5 or 7; 1: the central, axis-aligned filter alone)")
         ->check(CLI::IsMember({1, 3, 5, 7}));
     cmd.add_flag("--maaf-paper-rates", r.maafPaperRates,
-                 "maaf: the paper's pipeline: adaptive samples only at the focal plane (Sec. 6.2) and MAAF's central filter "
-                 "where there are no outer components, not AAF's rates and filter");
+                 "maaf: the paper's pipeline: adaptive samples only at the focal plane (Sec. 6.2), MAAF's central filter "
+                 "where there are no outer components and outer components for shadows too, not AAF's rates and filter");
     cmd.add_flag("!--no-focal-fallback", r.maafFocalFallback,
                  "maaf: keep all components where the defocus slope changes sign (shows the ringing)");
     cmd.add_flag("--maaf-windows", r.maafWindows,

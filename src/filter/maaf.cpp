@@ -192,7 +192,7 @@ MaafParams maafParams(const FrameBuffers& fb, const WedgeField& wf, const Filter
             out.pairs = 1;
             return;
         }
-        in.fallback = in.fallback || !single;
+        in.fallback = in.fallback || !single || !o.shadowComponents;
         in.step = frames.direct[p].step[k];
         in.yWedge = wf.s2[p] < kInf;
         in.omegaY = o.mu / wf.lightSigma[p];  // the light whose shadow this is (wedge_field.h)

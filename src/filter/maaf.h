@@ -138,6 +138,9 @@ struct MaafOptions {
     /// the rule as first written, which left spatialScale out; the whole window (1) measured worse
     /// (docs/maaf.md, "The fit rule").
     float fitShare = 0.40824829f;
+    // Outer components in the direct light's (shadow x lens) filter as well as the indirect
+    // light's; without them the direct filter is the central, axis-aligned one everywhere.
+    bool shadowComponents = true;
     bool symmetricOuter = true;      // outer components only where a neighbour's mirror is accepted too
     bool mirrorSurfaceCuts = true;   // as AafOptions::mirrorSurfaceCuts, for every component
 };

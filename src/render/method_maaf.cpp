@@ -56,6 +56,14 @@ void renderMaaf(const MethodContext& ctx, RenderResult& result) {
     mo.focalFallback = ctx.options.maafFocalFallback;
     mo.maxRadius = ctx.options.maafRadius;
     mo.fitComponents = ctx.options.maafFit;
+    // By default (AAF's pipeline, below) the direct light's filter has no outer components, only
+    // the indirect light's: on the six scenes at 256x256 against 1024-spp references they changed
+    // relMSE by -1.5% (cornell-sphere) to +7% (bunny) and +23% (grids-shadows, whose two layers of
+    // bars put two slopes in the filter's reach), and on a 2.8-px plank penumbra at AAF's
+    // adaptive rates by +61%
+    // (their bias, about 4e-5 there, stays while AAF's extra samples halve its variance); at equal
+    // samples without adaptive ones they win there (docs/maaf.md, "Shadow components").
+    mo.shadowComponents = ctx.options.maafPaperRates;
     if (mo.maxRadius < 1 || mo.maxRadius > filter::kMaafMaxWindowRadius)
         throw Error("--maaf-radius", "expected 1 to " + std::to_string(filter::kMaafMaxWindowRadius) + " pixels, got " +
                                          std::to_string(mo.maxRadius));

@@ -29,9 +29,10 @@ struct RenderOptions {
     int maxExtraSpp = kDefaultMaxExtraSpp;
     int maafComponents = 5;          // 2N-1 filters per 2D/3D subspace
     bool maafFocalFallback = true;   // fall back to the central filter where the defocus slope changes sign
-    // MAAF's pipeline as the paper has it (--maaf-paper-rates): its central filter everywhere and
-    // adaptive samples only at the focal plane (Sec. 6.2). By default AAF's rates and filter run
-    // everywhere and MAAF's filter only where it has outer components (method_maaf.cpp).
+    // MAAF's pipeline as the paper has it (--maaf-paper-rates): its slopes, its central filter
+    // everywhere, outer components for shadows too and adaptive samples only at the focal plane
+    // (Sec. 6.2). By default AAF's slopes, rates and filter run everywhere and MAAF's filter only
+    // where the indirect light's has outer components (method_maaf.cpp).
     bool maafPaperRates = false;
     bool maafWindows = false;        // eq. 20's Gaussian windows over light and lens samples
     int maafRadius = 10;             // the spatial filter's window, pixels (NOTES: the reimplementation's 10)
