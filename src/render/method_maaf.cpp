@@ -268,7 +268,7 @@ void renderMaaf(const MethodContext& ctx, RenderResult& result) {
     result.extra.emplace_back("maaf_accumulator_bytes", double((accDirect ? accDirect->allocatedBytes() : 0) +
                                                                (accIndirect ? accIndirect->allocatedBytes() : 0)));
     std::atomic<uint64_t> outerPixels{0};  // pixels whose accumulation has outer components
-    parallelRows(H, [&](int y) {
+    if (accDirect || accIndirect) parallelRows(H, [&](int y) {
         uint64_t outerInRow = 0;
         for (int x = 0; x < W; ++x) {
             size_t p = size_t(y) * W + x;
