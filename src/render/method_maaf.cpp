@@ -1,14 +1,15 @@
 // --method maaf: multiple axis-aligned filters (filter/maaf.h) as in Sec. 6.2 of the paper.
 // Stages: initial sampling (16 path samples per pixel with occluder spans, folded into the
-// pixel statistics); prefilter: slopes over a 5x5 window and components per pixel, and AAF's
-// slopes and rates; adaptive sampling at AAF's rates in every pixel (with --maaf-paper-rates
-// only where the wedge degenerates at the focal plane, Sec. 6.2), and the emitter and
-// mixed-pixel top-ups; the initial samples of the pixels with outer components traced again
-// (their adaptive samples are kept when taken); then the accumulation of eq. 23 over each
-// pixel's samples (the plain sums of the statistics where the pixel uses the central component
-// only); filter: AAF's, then eq. 21 on both image axes for direct and indirect light where the
-// effect has outer components (with --maaf-paper-rates eq. 21 everywhere), multiplied by albedo;
-// last, the defocus filter of the composited radiance (filter/defocus.h).
+// pixel statistics); prefilter: AAF's slopes (with --maaf-paper-rates MAAF's, over a 5x5
+// window), components per pixel and AAF's rates; adaptive sampling at AAF's rates in every pixel
+// (with --maaf-paper-rates only where the wedge degenerates at the focal plane, Sec. 6.2), and
+// the emitter and mixed-pixel top-ups; the initial samples of the pixels with outer components
+// traced again (their adaptive samples are kept when taken); then the accumulation of eq. 23
+// over each pixel's samples (the plain sums of the statistics where the pixel uses the central
+// component only); filter: AAF's, then eq. 21 on both image axes where the effect has outer
+// components (by default only the indirect light's has them; with --maaf-paper-rates eq. 21
+// everywhere, for direct and indirect light), multiplied by albedo; last, the defocus filter of
+// the composited radiance (filter/defocus.h).
 #include <algorithm>
 #include <atomic>
 #include <cmath>
@@ -60,9 +61,9 @@ void renderMaaf(const MethodContext& ctx, RenderResult& result) {
     // the indirect light's: on the six scenes at 256x256 against 1024-spp references they changed
     // relMSE by -1.5% (cornell-sphere) to +7% (bunny) and +23% (grids-shadows, whose two layers of
     // bars put two slopes in the filter's reach), and on a 2.8-px plank penumbra at AAF's
-    // adaptive rates by +61%
-    // (their bias, about 4e-5 there, stays while AAF's extra samples halve its variance); at equal
-    // samples without adaptive ones they win there (docs/maaf.md, "Shadow components").
+    // adaptive rates by +61% (their bias, about 4e-5 there, stays while AAF's extra samples halve
+    // its variance); at equal samples without adaptive ones they win there (docs/maaf.md,
+    // "Shadow components").
     mo.shadowComponents = ctx.options.maafPaperRates;
     if (mo.maxRadius < 1 || mo.maxRadius > filter::kMaafMaxWindowRadius)
         throw Error("--maaf-radius", "expected 1 to " + std::to_string(filter::kMaafMaxWindowRadius) + " pixels, got " +
