@@ -17,6 +17,7 @@
 #include <cmath>
 #include <cstdint>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "core/image.h"
@@ -91,6 +92,8 @@ struct LightFieldSample {
     bool hit() const { return depth < kInf; }
 };
 static_assert(sizeof(LightFieldSample) == 24);
+static_assert(std::is_trivially_copyable_v<LightFieldSample> && std::is_trivially_destructible_v<LightFieldSample>,
+              "LightFieldSamples leaves its samples unwritten until they are recorded (UnwrittenAllocator)");
 
 /// Every pixel's samples, stage by stage: a stage holds, for each pixel, a run of samples whose
 /// length is fixed when the stage is added (the initial spp, the adaptive counts).
@@ -116,7 +119,7 @@ public:
         for (size_t p = 0; p < pixels; ++p) s.offset[p + 1] = s.offset[p] + count(p);
         checkMemory("--layers", "keeping every sample (" + std::to_string(s.offset[pixels] + samples()) + " at 24 bytes)",
                     uint64_t(bytes() + s.offset[pixels] * sizeof(LightFieldSample)));
-        s.samples = LargeVector<LightFieldSample>(s.offset[pixels]);
+        s.samples = Samples(s.offset[pixels]);  // unwritten: every slot is written once, by its pixel's thread
         m_stages.push_back(std::move(s));
         return int(m_stages.size()) - 1;
     }
@@ -154,9 +157,13 @@ public:
     }
 
 private:
+    // Left unwritten when allocated (UnwrittenAllocator): each sample is written once as it is
+    // recorded (or copied from its rank), so the pages are first touched by the sampling
+    // threads, not zeroed by one thread before (Sponza 512x512, 16 spp: 100 MB).
+    using Samples = std::vector<LightFieldSample, UnwrittenAllocator<LightFieldSample>>;
     struct Stage {
         std::vector<uint64_t> offset;  // pixels + 1
-        LargeVector<LightFieldSample> samples;
+        Samples samples;
     };
     int m_width = 0, m_height = 0;
     std::vector<Stage> m_stages;
