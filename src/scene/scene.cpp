@@ -17,36 +17,6 @@ void embreeError(void*, RTCError code, const char* str) {
     std::fprintf(stderr, "wedge: Embree error %d: %s\n", int(code), str ? str : "");
 }
 
-void toRtc(const RayPacket& r, RTCRay16& ray) {
-    for (int i = 0; i < RayPacket::kSize; ++i) {
-        ray.org_x[i] = r.org[i].x;
-        ray.org_y[i] = r.org[i].y;
-        ray.org_z[i] = r.org[i].z;
-        ray.dir_x[i] = r.dir[i].x;
-        ray.dir_y[i] = r.dir[i].y;
-        ray.dir_z[i] = r.dir[i].z;
-        ray.tnear[i] = 0.f;
-        ray.tfar[i] = r.valid[i] ? r.tFar[i] : -kInf;
-        ray.time[i] = r.time[i];
-        ray.mask[i] = 0xffffffffu;
-        ray.id[i] = unsigned(i);
-        ray.flags[i] = 0;
-    }
-}
-
-/// Closest hits of a packet's valid lanes (geomID RTC_INVALID_GEOMETRY_ID where none).
-void closestHits(RTCScene scene, const RayPacket& rays, const int* valid, RTCRayHit16& rh, bool coherent) {
-    RTCIntersectContext ctx;
-    rtcInitIntersectContext(&ctx);
-    if (coherent) ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
-    toRtc(rays, rh.ray);
-    for (int i = 0; i < RayPacket::kSize; ++i) {
-        rh.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
-        rh.hit.instID[0][i] = RTC_INVALID_GEOMETRY_ID;
-    }
-    rtcIntersect16(valid, scene, &ctx, &rh);
-}
-
 RTCRayHit makeRayHit(const Vec3f& o, const Vec3f& d, float tNear, float tFar, float time) {
     RTCRayHit rh;
     rh.ray.org_x = o.x; rh.ray.org_y = o.y; rh.ray.org_z = o.z;
@@ -190,16 +160,29 @@ bool Scene::intersect(const Vec3f& org, const Vec3f& dir, float tNear, float tFa
     return true;
 }
 
-void Scene::intersect(const RayPacket& rays, Hit hits[RayPacket::kSize], bool found[RayPacket::kSize], bool coherent) const {
-    if (!coherent) {
-        // Measured on Sponza: incoherent bounce rays are faster one by one than as a packet
-        // or an Embree ray stream.
-        for (int k = 0; k < RayPacket::kSize; ++k)
-            found[k] = rays.valid[k] && intersect(rays.org[k], rays.dir[k], 0.f, rays.tFar[k], rays.time[k], hits[k]);
-        return;
-    }
+void Scene::intersect(const RayPacket& rays, Hit hits[RayPacket::kSize], bool found[RayPacket::kSize]) const {
+    // One pixel's camera rays: coherent, a 16-wide packet.
     alignas(64) RTCRayHit16 rh;
-    closestHits(m_scene, rays, rays.valid, rh, true);
+    for (int i = 0; i < RayPacket::kSize; ++i) {
+        rh.ray.org_x[i] = rays.org[i].x;
+        rh.ray.org_y[i] = rays.org[i].y;
+        rh.ray.org_z[i] = rays.org[i].z;
+        rh.ray.dir_x[i] = rays.dir[i].x;
+        rh.ray.dir_y[i] = rays.dir[i].y;
+        rh.ray.dir_z[i] = rays.dir[i].z;
+        rh.ray.tnear[i] = 0.f;
+        rh.ray.tfar[i] = rays.valid[i] ? rays.tFar[i] : -kInf;
+        rh.ray.time[i] = rays.time[i];
+        rh.ray.mask[i] = 0xffffffffu;
+        rh.ray.id[i] = unsigned(i);
+        rh.ray.flags[i] = 0;
+        rh.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
+        rh.hit.instID[0][i] = RTC_INVALID_GEOMETRY_ID;
+    }
+    RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+    rtcIntersect16(rays.valid, m_scene, &ctx, &rh);
     // A hit's per-primitive data (corner normals, material, uv) is a cache miss on a large
     // mesh: requested for all lanes first, so that the misses overlap.
     for (int i = 0; i < RayPacket::kSize; ++i)
@@ -210,46 +193,6 @@ void Scene::intersect(const RayPacket& rays, Hit hits[RayPacket::kSize], bool fo
             fillHit(rays.org[i], rays.dir[i], rh.ray.tfar[i], rays.time[i], rh.hit.geomID[i], rh.hit.primID[i],
                     Vec3f(rh.hit.Ng_x[i], rh.hit.Ng_y[i], rh.hit.Ng_z[i]), rh.hit.u[i], rh.hit.v[i], hits[i]);
     }
-}
-
-void Scene::occluded(const RayPacket& rays, bool occluded[RayPacket::kSize]) const {
-    RTCIntersectContext ctx;
-    rtcInitIntersectContext(&ctx);
-    alignas(64) RTCRay16 ray;
-    toRtc(rays, ray);
-    rtcOccluded16(rays.valid, m_scene, &ctx, &ray);
-    for (int i = 0; i < RayPacket::kSize; ++i) occluded[i] = rays.valid[i] && ray.tfar[i] < 0;
-}
-
-void Scene::occluders(const RayPacket& rays, OccluderSpan spans[RayPacket::kSize]) const {
-    // Two closest-hit queries instead of one traversal that visits every hit: the nearest
-    // occluder from the receiver, then, for the lanes that found one, the nearest occluder seen
-    // from the segment's far end (the light) looking back, which is the farthest one from the
-    // receiver. Closest-hit traversal culls by distance and needs no filter callback; measured
-    // on Sponza 512x512 (16 spp with spans) it is faster than the all-hits filter (README).
-    alignas(64) RTCRayHit16 rh;
-    closestHits(m_scene, rays, rays.valid, rh, false);
-    alignas(64) int back[RayPacket::kSize];
-    bool anyBack = false;
-    for (int i = 0; i < RayPacket::kSize; ++i) {
-        bool hit = rays.valid[i] && rh.hit.geomID[i] != RTC_INVALID_GEOMETRY_ID;
-        spans[i] = hit ? OccluderSpan{true, rh.ray.tfar[i], rh.ray.tfar[i]} : OccluderSpan{};
-        back[i] = hit ? -1 : 0;
-        anyBack |= hit;
-    }
-    if (!anyBack) return;
-    RayPacket reverse;
-    for (int i = 0; i < RayPacket::kSize; ++i)
-        if (back[i]) {
-            // From the far end back to just past the nearest occluder, which it must find again
-            // at the latest (a small slack for the reversed ray's rounding).
-            float len = rays.tFar[i], slack = 1e-4f * len;
-            reverse.set(i, rays.org[i] + rays.dir[i] * len, -rays.dir[i], len - spans[i].tNear + slack, rays.time[i]);
-        }
-    closestHits(m_scene, reverse, back, rh, false);
-    for (int i = 0; i < RayPacket::kSize; ++i)
-        if (back[i] && rh.hit.geomID[i] != RTC_INVALID_GEOMETRY_ID)
-            spans[i].tFar = std::max(spans[i].tNear, rays.tFar[i] - rh.ray.tfar[i]);
 }
 
 namespace {
@@ -298,8 +241,11 @@ void Scene::occluded(const RaySegment* rays, size_t n, bool* occluded) const {
 }
 
 void Scene::occluders(const RaySegment* rays, size_t n, OccluderSpan* spans) const {
-    // As the packet query: the nearest occluder from the receiver, then, for the rays that found
-    // one, the nearest seen from the far end looking back (the farthest from the receiver).
+    // Two closest-hit queries instead of one traversal that visits every hit: the nearest
+    // occluder from the receiver, then, for the rays that found one, the nearest occluder seen
+    // from the segment's far end (the light) looking back, which is the farthest one from the
+    // receiver. Closest-hit traversal culls by distance and needs no filter callback; measured
+    // on Sponza 512x512 (16 spp with spans) it is faster than the all-hits filter (README).
     if (n == 0) return;
     std::vector<RTCRayHit>& rh = streamScratch(n);
     for (size_t i = 0; i < n; ++i) rh[i] = makeRayHit(rays[i].org, rays[i].dir, 0.f, rays[i].tFar, rays[i].time);
@@ -311,6 +257,8 @@ void Scene::occluders(const RaySegment* rays, size_t n, OccluderSpan* spans) con
         const bool hit = rh[i].hit.geomID != RTC_INVALID_GEOMETRY_ID;
         spans[i] = hit ? OccluderSpan{true, rh[i].ray.tfar, rh[i].ray.tfar} : OccluderSpan{};
         if (!hit) continue;
+        // From the far end back to just past the nearest occluder, which it must find again at
+        // the latest (a small slack for the reversed ray's rounding).
         float len = rays[i].tFar, slack = 1e-4f * len;
         rh[back] = makeRayHit(rays[i].org + rays[i].dir * len, -rays[i].dir, 0.f, len - spans[i].tNear + slack, rays[i].time);
         rh[back].ray.id = unsigned(i);
@@ -334,16 +282,15 @@ bool Scene::occluded(const Vec3f& org, const Vec3f& dir, float tNear, float tFar
 }
 
 OccluderSpan Scene::occluders(const Vec3f& org, const Vec3f& dir, float tNear, float tFar, float time) const {
-    // One lane of the packet query, so that both paths are the same code.
-    RayPacket packet;
-    packet.set(0, org + dir * tNear, dir, tFar - tNear, time);
-    OccluderSpan spans[RayPacket::kSize];
-    occluders(packet, spans);
-    if (spans[0].occluded) {
-        spans[0].tNear += tNear;
-        spans[0].tFar += tNear;
+    // A stream of one, so that both paths are the same code.
+    const RaySegment ray{org + dir * tNear, dir, tFar - tNear, time};
+    OccluderSpan span;
+    occluders(&ray, 1, &span);
+    if (span.occluded) {
+        span.tNear += tNear;
+        span.tFar += tNear;
     }
-    return spans[0];
+    return span;
 }
 
 }  // namespace wedge::scene

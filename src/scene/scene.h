@@ -90,14 +90,12 @@ public:
     bool occluded(const Vec3f& org, const Vec3f& dir, float tNear, float tFar, float time) const;
     OccluderSpan occluders(const Vec3f& org, const Vec3f& dir, float tNear, float tFar, float time) const;
 
-    /// Packet versions (tNear = 0): coherent rays of one pixel's samples traverse together.
-    /// `coherent`: trace as one packet (a pixel's primary rays); otherwise ray by ray (bounces).
-    void intersect(const RayPacket& rays, Hit hits[RayPacket::kSize], bool found[RayPacket::kSize], bool coherent) const;
-    void occluded(const RayPacket& rays, bool occluded[RayPacket::kSize]) const;
-    void occluders(const RayPacket& rays, OccluderSpan spans[RayPacket::kSize]) const;
-    /// The same queries over a stream of n rays (Embree's rtcOccluded1M / rtcIntersect1M). On
-    /// Sponza's shadow rays a stream of 256 (16 pixels' samples) is 1.2-1.4x as fast as the
-    /// pixels' 16-wide packets (bench/embree_ceiling.cpp, docs/sampling-speed.md).
+    /// Closest hits of one pixel's camera rays (tNear = 0), coherent: one 16-wide packet.
+    void intersect(const RayPacket& rays, Hit hits[RayPacket::kSize], bool found[RayPacket::kSize]) const;
+    /// The queries over a stream of n rays (tNear = 0; Embree's rtcOccluded1M / rtcIntersect1M),
+    /// each ray's answer what it gets alone. On Sponza's shadow rays a stream of 256 (16 pixels'
+    /// samples) is 1.2-1.4x as fast as one pixel's 16-wide packet (bench/embree_ceiling.cpp,
+    /// docs/sampling-speed.md).
     void occluded(const RaySegment* rays, size_t n, bool* occluded) const;
     /// Closest hits of a stream (found[i] false where none).
     void intersect(const RaySegment* rays, size_t n, Hit* hits, bool* found) const;
