@@ -249,11 +249,8 @@ void renderMaaf(const MethodContext& ctx, RenderResult& result) {
         std::vector<PathSampler::SampleRun> runs;
         for (int x = 0; x < W; ++x)
             if (outer(size_t(y) * W + x)) runs.push_back({x, y, 0, n0, nullptr});
-        std::vector<TracedSample> traced(runs.size() * n0);
-        for (size_t i = 0; i < runs.size(); ++i) runs[i].out = traced.data() + i * n0;
-        const size_t perCall = std::max<size_t>(1, 256 / std::max<uint32_t>(n0, 1));
-        for (size_t i = 0; i < runs.size(); i += perCall)
-            ctx.sampler.traceMany(runs.data() + i, std::min(perCall, runs.size() - i), false);
+        std::vector<TracedSample> traced;
+        ctx.sampler.traceRuns(runs, traced, false);
         for (const auto& run : runs) {
             const size_t p = size_t(y) * W + run.x;
             for (uint32_t k = 0; k < n0; ++k) {

@@ -196,8 +196,11 @@ struct PathSampler::Wave {
     bool occluded[kLanes];
     scene::OccluderSpan spans[kLanes];
     int nRays = 0;
-    void push(int l, const Vec3f& org, const Vec3f& dir, float tFar, float t) {
-        rays[nRays] = {org, dir, tFar, t};
+    /// Queues the shadow ray of lane (or bounce) l from `org` to just short of `lightPoint`.
+    void pushShadow(int l, const Vec3f& org, const Vec3f& lightPoint, float t) {
+        const Vec3f toPoint = lightPoint - org;
+        const float dist = length(toPoint);
+        rays[nRays] = {org, toPoint / dist, dist * (1.f - 1e-4f), t};
         lane[nRays++] = uint16_t(l);
     }
 };
@@ -205,6 +208,18 @@ struct PathSampler::Wave {
 void PathSampler::traceBatch(int x, int y, uint32_t first, uint32_t count, bool span, TracedSample* outs) const {
     const SampleRun run{x, y, first, count, outs};
     traceMany(&run, 1, span);
+}
+
+void PathSampler::traceRuns(std::vector<SampleRun>& runs, std::vector<TracedSample>& buffer, bool span) const {
+    size_t total = 0;
+    for (const SampleRun& run : runs) total += run.count;
+    if (buffer.size() < total) buffer.resize(total);
+    size_t offset = 0;
+    for (SampleRun& run : runs) {
+        run.out = buffer.data() + offset;
+        offset += run.count;
+    }
+    traceMany(runs.data(), runs.size(), span);
 }
 
 void PathSampler::traceMany(const SampleRun* runs, size_t nRuns, bool span) const {
@@ -255,7 +270,7 @@ void PathSampler::traceMany(const SampleRun* runs, size_t nRuns, bool span) cons
                 out[k].rays = 1;
             }
             if (m_log) m_log->add(scene::RayLog::kPrimary, primary);
-            m_scene.intersect(primary, w.hit + l0, w.found + l0, true);
+            m_scene.intersect(primary, w.hit + l0, w.found + l0);
 
             // Direct light at the primary hits: one light sample each, its shadow ray queued.
             for (int k = 0; k < n; ++k) {
@@ -294,10 +309,7 @@ void PathSampler::traceMany(const SampleRun* runs, size_t nRuns, bool span) cons
                     o.occluded = o.selfShadowed = true;
                     continue;
                 }
-                const Vec3f org = offset(hit.position, w.geometric[l]);
-                const Vec3f toPoint = ls.point - org;
-                const float dist = length(toPoint);
-                w.push(l, org, toPoint / dist, dist * (1.f - 1e-4f), w.time[l]);
+                w.pushShadow(l, offset(hit.position, w.geometric[l]), ls.point, w.time[l]);
                 ++o.rays;
             }
         }
@@ -350,10 +362,7 @@ void PathSampler::traceMany(const SampleRun* runs, size_t nRuns, bool span) cons
                 const LightSample& l2 = w.l2[j] =
                     sampleLight(h2.position, facing(h2.shadingNormal, g2), w.uBounceLight[l], w.choice[l]);
                 if (maxComponent(l2.irradiance) <= 0 || dot(l2.toLight, g2) <= 0) continue;
-                const Vec3f org2 = offset(h2.position, g2);
-                const Vec3f toPoint = l2.point - org2;
-                const float dist = length(toPoint);
-                w.push(j, org2, toPoint / dist, dist * (1.f - 1e-4f), w.time[l]);
+                w.pushShadow(j, offset(h2.position, g2), l2.point, w.time[l]);
                 ++o.rays;
             }
             if (m_log) m_log->add(scene::RayLog::kBounceShadow, w.rays, size_t(w.nRays));
@@ -387,7 +396,7 @@ Vec3f PathSampler::meanEmission(int x, int y, uint32_t count) const {
         cameraRays(rng, x, y, first, n, primary, lens, choice, time, nullptr);
         scene::Hit hit[K];
         bool found[K] = {};
-        m_scene.intersect(primary, hit, found, true);
+        m_scene.intersect(primary, hit, found);
         for (int k = 0; k < n; ++k)
             if (found[k] && dot(hit[k].normal, primary.dir[k]) < 0)  // emitters shine from their front
                 sum += m_scene.material(hit[k].material).emission;

@@ -57,9 +57,8 @@ public:
     /// Traces sample `index` of pixel (x, y). With `span`, the primary shadow ray collects the
     /// nearest and farthest occluder (all hits along it) instead of stopping at the first.
     TracedSample trace(int x, int y, uint32_t index, bool span) const;
-    /// Traces samples first .. first+count-1 of pixel (x, y) into out[0..count), up to 16 at a
-    /// time as Embree ray packets (a pixel's primary and shadow rays are coherent). The same
-    /// samples as trace() one by one.
+    /// Traces samples first .. first+count-1 of pixel (x, y) into out[0..count): traceMany with
+    /// one run. The same samples as trace() one by one.
     void traceBatch(int x, int y, uint32_t first, uint32_t count, bool span, TracedSample* out) const;
     /// Samples first .. first+count-1 of pixel (x, y), into out[0..count): one of traceMany's runs.
     struct SampleRun {
@@ -71,6 +70,9 @@ public:
     /// stream of up to 256 (faster than 16-wide packets: docs/sampling-speed.md). The same
     /// samples as traceBatch on each run.
     void traceMany(const SampleRun* runs, size_t n, bool span) const;
+    /// traceMany into `buffer`, grown to hold the runs' samples one run after another, with each
+    /// run's `out` pointed at its part.
+    void traceRuns(std::vector<SampleRun>& runs, std::vector<TracedSample>& buffer, bool span) const;
 
     /// The mean emitted radiance that the camera rays of samples 0 .. count-1 of pixel (x, y)
     /// see: the emitted part of those path samples, from their primary rays alone (no light

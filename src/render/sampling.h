@@ -64,13 +64,7 @@ uint64_t samplePixels(const PathSampler& sampler, PixelStatsImage& stats, const 
         std::vector<TracedSample> traced;
         uint32_t queued = 0;
         auto flush = [&] {
-            traced.resize(std::max<size_t>(traced.size(), queued));
-            uint32_t offset = 0;
-            for (auto& run : runs) {
-                run.out = traced.data() + offset;
-                offset += run.count;
-            }
-            sampler.traceMany(runs.data(), runs.size(), span);
+            sampler.traceRuns(runs, traced, span);
             for (const auto& run : runs) {
                 PixelStats& ps = stats(run.x, run.y);
                 for (uint32_t k = 0; k < run.count; ++k) {
