@@ -131,45 +131,44 @@ TEST(Mpi, ASceneErrorIsReportedOnceWithExitTwoAndNothingWritten) {
     EXPECT_FALSE(fs::exists(dir + "/x.exr"));
 }
 
+/// A small cornell render over `ranks` ranks with a fault injected through `env`
+/// (WEDGE_MPI_FAULT, WEDGE_MPI_TIMEOUT): returns the job's exit code and checks that it wrote
+/// nothing.
+int runFaultyJob(int ranks, const std::string& env, std::string* err) {
+    const std::string dir = tempDir();
+    const int rc = runRanks(ranks, "render cornell --spp 2 --resolution 32x24 --quiet -o " + dir + "/x.exr", err, env);
+    EXPECT_FALSE(fs::exists(dir + "/x.exr")) << *err;
+    return rc;
+}
+
 TEST(Mpi, AFailingRankEndsTheJobWithItsMessage) {
     REQUIRE_MPI();
     // Rank 1 fails at its first exchange while ranks 0 and 2 go on to theirs: they learn of it
     // there and every rank exits with its code (1: an internal error), nothing written.
-    const std::string dir = tempDir();
     std::string err;
-    EXPECT_EQ(runRanks(3, "render cornell --spp 2 --resolution 32x24 --quiet -o " + dir + "/x.exr", &err,
-                       "WEDGE_MPI_FAULT=1:fail"),
-              1)
-        << err;
+    EXPECT_EQ(runFaultyJob(3, "WEDGE_MPI_FAULT=1:fail", &err), 1) << err;
     EXPECT_EQ(occurrences(err, "wedge: internal error (rank 1): injected failure"), 1u) << err;
-    EXPECT_FALSE(fs::exists(dir + "/x.exr"));
 }
 
 TEST(Mpi, AHangingRankEndsTheJobAfterTheTimeout) {
     REQUIRE_MPI();
     // Rank 1 never reaches its exchange: rank 0 gives up after WEDGE_MPI_TIMEOUT seconds and
     // aborts the job (within runRanks' 120 s, which would report a hang as -1 or 124).
-    const std::string dir = tempDir();
     std::string err;
-    const int rc = runRanks(2, "render cornell --spp 2 --resolution 32x24 --quiet -o " + dir + "/x.exr", &err,
-                            "WEDGE_MPI_FAULT=1:hang WEDGE_MPI_TIMEOUT=2");
+    const int rc = runFaultyJob(2, "WEDGE_MPI_FAULT=1:hang WEDGE_MPI_TIMEOUT=2", &err);
     EXPECT_NE(rc, 0) << err;
     EXPECT_NE(rc, 124) << "timed out: the job hung\n" << err;
     EXPECT_NE(err.find("wedge: error (rank 0): waited"), std::string::npos) << err;
-    EXPECT_FALSE(fs::exists(dir + "/x.exr"));
 }
 
 TEST(Mpi, ARankThatDiesEndsTheJob) {
     REQUIRE_MPI();
     // Rank 1 is killed (SIGKILL) at its first exchange: mpirun ends the job and says which rank.
-    const std::string dir = tempDir();
     std::string err;
-    const int rc = runRanks(2, "render cornell --spp 2 --resolution 32x24 --quiet -o " + dir + "/x.exr", &err,
-                            "WEDGE_MPI_FAULT=1:die");
+    const int rc = runFaultyJob(2, "WEDGE_MPI_FAULT=1:die", &err);
     EXPECT_NE(rc, 0) << err;
     EXPECT_NE(rc, 124) << "timed out: the job hung\n" << err;
     EXPECT_NE(err.find("rank 1"), std::string::npos) << err;
-    EXPECT_FALSE(fs::exists(dir + "/x.exr"));
 }
 
 TEST(Mpi, OneRankUnderMpirunIsOneProcess) {
