@@ -5,6 +5,7 @@
 // counts: render_test.cpp).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <random>
@@ -76,6 +77,46 @@ TEST(LightField, SharedExponentColoursRoundTrip) {
     EXPECT_EQ(unpackRgb9e5(packRgb9e5(Vec3f(-1.f, std::nanf(""), 0.f))), Vec3f(0.f));
     EXPECT_EQ(unpackRgb9e5(packRgb9e5(Vec3f(1.f, 0.5f, 0.25f))), Vec3f(1.f, 0.5f, 0.25f));  // exact in 9 bits
     EXPECT_NEAR(unpackRgb9e5(packRgb9e5(Vec3f(1e9f))).x, 65408.f, 1.f);                   // clamped to the largest
+}
+
+// The packing as first written, with libm (std::log2, std::ldexp, std::lround): the bit-level
+// one must give the same bytes.
+static uint32_t packRgb9e5WithLibm(const Vec3f& c) {
+    auto clampC = [&](float v) { return v > 0.f ? std::min(v, 65408.f) : 0.f; };
+    const float r = clampC(c.x), g = clampC(c.y), b = clampC(c.z);
+    const float m = std::max({r, g, b});
+    if (!(m > 0.f)) return 0;
+    int e = std::max(-16, int(std::floor(std::log2(m)))) + 16;
+    float scale = std::ldexp(1.f, 24 - e);
+    if (std::floor(m * scale + 0.5f) >= 512.f) scale = std::ldexp(1.f, 24 - ++e);
+    auto mant = [&](float v) { return uint32_t(std::min(511.f, std::floor(v * scale + 0.5f))); };
+    return mant(r) | (mant(g) << 9) | (mant(b) << 18) | (uint32_t(std::min(e, 31)) << 27);
+}
+
+TEST(LightField, PackingIsTheLibmFormulaBitForBit) {
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<float> unit(0.f, 1.f), exponent(-20.f, 17.f);
+    std::vector<float> values;
+    for (int i = 0; i < 200000; ++i) values.push_back(unit(rng) * std::exp2(exponent(rng)));
+    for (int k = -20; k <= 16; ++k)  // around powers of two and the mantissa's rounding steps
+        for (float f : {1.f, 0.99999994f, 1.0000001f, 1.f - 1.f / 1024, 1.f - 1.f / 1023, 1.f + 1.f / 512})
+            values.push_back(std::ldexp(f, k));
+    for (size_t i = 0; i + 2 < values.size(); ++i) {
+        const Vec3f c(values[i], values[i + 1] * 0.3f, values[i + 2]);
+        ASSERT_EQ(packRgb9e5(c), packRgb9e5WithLibm(c)) << c.x << " " << c.y << " " << c.z;
+        const Vec3f one(values[i]);
+        ASSERT_EQ(packRgb9e5(one), packRgb9e5WithLibm(one)) << values[i];
+    }
+    // Lens, motion and time are rounded half away from zero, as std::lround.
+    for (int i = -70000; i <= 70000; ++i) {
+        const float v = float(i) / 65534.f;  // every half step of the lens's 1/32767
+        const LightFieldSample s = LightFieldSample::pack({0.5f, 0.5f}, {std::clamp(v, -1.f, 1.f), 0.f}, std::clamp(v, 0.f, 1.f), 1.f,
+                                                          {v * 100.f, -v * 100.f}, Vec3f(1.f), Vec3f(1.f), 0);
+        ASSERT_EQ(s.lensU, int16_t(std::lround(std::clamp(v, -1.f, 1.f) * 32767.f))) << v;
+        ASSERT_EQ(s.motionX, int16_t(std::lround(v * 100.f * 8.f))) << v;
+        ASSERT_EQ(s.motionY, int16_t(std::lround(-v * 100.f * 8.f))) << v;
+        ASSERT_EQ(s.timeSurface & 0x3fffu, uint32_t(std::lround(std::clamp(v, 0.f, 1.f) * 16383.f))) << v;
+    }
 }
 
 TEST(LightField, APackedSampleKeepsItsCoordinates) {

@@ -35,11 +35,14 @@ inline uint32_t packRgb9e5(const Vec3f& c) {
     const float r = clampC(c.x), g = clampC(c.y), b = clampC(c.z);
     const float m = std::max({r, g, b});
     if (!(m > 0.f)) return 0;
-    // The shared exponent e (biased by 15): mantissa = v / 2^(e - 15 - 9), at most 511.
-    int e = std::max(-16, int(std::floor(std::log2(m)))) + 16;
-    float scale = std::ldexp(1.f, 24 - e);
-    if (std::floor(m * scale + 0.5f) >= 512.f) scale = std::ldexp(1.f, 24 - ++e);  // rounding reached 2^9
-    auto mant = [&](float v) { return uint32_t(std::min(511.f, std::floor(v * scale + 0.5f))); };
+    // The shared exponent e (biased by 15): mantissa = v / 2^(e - 15 - 9), at most 511. floor(log2 m)
+    // is m's own binary exponent (read from its bits: std::log2 rounded up to the next integer
+    // just below powers of two, and with std::ldexp was a third of recording a sample).
+    auto pow2 = [](int k) { return std::bit_cast<float>(uint32_t(k + 127) << 23); };  // 2^k, |k| < 127
+    int e = std::max(-16, int((std::bit_cast<uint32_t>(m) >> 23) & 255u) - 127) + 16;
+    float scale = pow2(24 - e);
+    if (uint32_t(m * scale + 0.5f) >= 512u) scale = pow2(24 - ++e);  // rounding reached 2^9
+    auto mant = [&](float v) { return std::min(511u, uint32_t(v * scale + 0.5f)); };
     return mant(r) | (mant(g) << 9) | (mant(b) << 18) | (uint32_t(std::min(e, 31)) << 27);
 }
 
@@ -63,7 +66,9 @@ struct LightFieldSample {
 
     static LightFieldSample pack(Vec2f film, Vec2f lens, float time, float depth, Vec2f motion, const Vec3f& albedo,
                                  const Vec3f& radiance, int surface) {
-        auto q16 = [](float v, float s, float lim) { return int16_t(std::lround(std::clamp(v, -lim, lim) * s)); };
+        // Rounded half away from zero as std::lround, without the call (x + 0.5 is exact in a double).
+        auto roundHalfAway = [](float x) { return x >= 0 ? int(double(x) + 0.5) : x < 0 ? -int(0.5 - double(x)) : 0; };  // NaN -> 0
+        auto q16 = [&](float v, float s, float lim) { return int16_t(roundHalfAway(std::clamp(v, -lim, lim) * s)); };
         LightFieldSample s;
         s.depth = depth;
         s.albedo = packRgb9e5(albedo);
@@ -72,7 +77,7 @@ struct LightFieldSample {
         s.lensV = q16(lens.y, 32767.f, 1.f);
         s.motionX = q16(motion.x, 8.f, kMaxMotion);
         s.motionY = q16(motion.y, 8.f, kMaxMotion);
-        const uint32_t t = uint32_t(std::lround(std::clamp(time, 0.f, 1.f) * 16383.f));
+        const uint32_t t = uint32_t(roundHalfAway(std::clamp(time, 0.f, 1.f) * 16383.f));
         s.timeSurface = uint16_t(t | (uint32_t(std::clamp(surface + 1, 0, 3)) << 14));
         s.filmX = uint8_t(std::clamp(int(film.x * 256.f), 0, 255));
         s.filmY = uint8_t(std::clamp(int(film.y * 256.f), 0, 255));
