@@ -61,17 +61,19 @@ struct Layer {
     // (Half-pixel cells blur less but are noisier: AAF relMSE on conference at 512x512 0.000625
     // -> 0.000842.)
     int gx0 = 0, gy0 = 0, gw = 0, gh = 0;
-    // Per cell: N, D, then per time bin W, R, G, B (accumulated), or alpha, then per time bin
+    // Per cell: N, then per time bin W, R, G, B (accumulated), or alpha, then per time bin
     // R, G, B (resolved); last, the layer's own slope there (a slanted surface's changes across
-    // the tile, which the rays follow).
-    std::vector<float> acc, cell;
+    // the tile, which the rays follow). D has a grid of its own (accD): every sample behind the
+    // layer adds to it, at scattered cells, and a 4-byte cell keeps those writes in cache (a
+    // moving layer's accumulated cell is 136 bytes).
+    std::vector<float> acc, accD, cell;
     /// Summed-area table of the cells with alpha > 0 ((gw + 1) x (gh + 1)): a pixel whose rays
     /// can reach only uncovered cells skips the layer (exactly: it would add nothing there).
     std::vector<int> covered;
     /// How far (pixels) a ray's lookups can land from the pixel: the largest slope (the rays
     /// follow the slope they find, never beyond the layer's extremes) and half the motion.
     float rayReach = 0;
-    int accStride() const { return 3 + 4 * timeBins; }   // ... and last the sum of the samples' slopes
+    int accStride() const { return 2 + 4 * timeBins; }   // ... and last the sum of the samples' slopes
     int cellStride() const { return 2 + 3 * timeBins; }  // ... and last the samples' mean slope there
 
     Vec2f sharpPosition(const Gathered& s) const {
@@ -110,61 +112,82 @@ struct Layer {
     }
 };
 
+/// The slopes of one class of a tile's samples (still or moving), gathered as they are read.
+struct SlopeRange {
+    float lo = kInf, hi = -kInf;
+    size_t n = 0;
+    void add(float c) {
+        lo = std::min(lo, c);
+        hi = std::max(hi, c);
+        ++n;
+    }
+};
+
 /// Splits the tile's samples into layers, front to back (see layers.h, step 1); sets
-/// Gathered::layer.
-std::vector<Layer> splitLayers(std::vector<Gathered>& g, const LayerOptions& o) {
+/// Gathered::layer. `range[moving]`: the slopes of the still and the moving samples. Two passes
+/// over the samples, both classes at once (the tile's samples are megabytes: each pass is a
+/// trip through memory).
+std::vector<Layer> splitLayers(std::vector<Gathered>& g, const SlopeRange (&range)[2], const LayerOptions& o) {
+    // Per class, a histogram of slopes, nearest (largest c) first.
+    struct Histogram {
+        float cHi = 0, binW = 1;
+        int bins = 0, base = 0;
+        std::vector<int> count, binLayer;
+        int bin(float c) const { return std::clamp(int((cHi - c) / binW), 0, bins - 1); }
+    };
+    Histogram hist[2];
+    for (int moving = 0; moving < 2; ++moving) {
+        const SlopeRange& r = range[moving];
+        if (r.n == 0) continue;
+        Histogram& h = hist[moving];
+        h.cHi = r.hi;
+        h.binW = std::max(0.25f, (r.hi - r.lo) / 2048.f);
+        h.bins = int((r.hi - r.lo) / h.binW) + 1;
+        h.count.assign(h.bins, 0);
+        h.binLayer.assign(h.bins, -1);
+    }
+    for (const Gathered& s : g) {
+        const Histogram& h = hist[s.moving];
+        ++hist[s.moving].count[h.bin(s.c)];
+    }
     std::vector<Layer> layers;
     for (int moving = 0; moving < 2; ++moving) {
-        float cLo = kInf, cHi = -kInf;
-        size_t n = 0;
-        for (const Gathered& s : g)
-            if (s.moving == bool(moving)) {
-                cLo = std::min(cLo, s.c);
-                cHi = std::max(cHi, s.c);
-                ++n;
-            }
-        if (n == 0) continue;
-        // A histogram of slopes, nearest (largest c) first.
-        const float binW = std::max(0.25f, (cHi - cLo) / 2048.f);
-        const int bins = int((cHi - cLo) / binW) + 1;
-        std::vector<int> count(bins, 0), binLayer(bins, -1);
-        auto bin = [&](float c) { return std::clamp(int((cHi - c) / binW), 0, bins - 1); };
-        for (const Gathered& s : g)
-            if (s.moving == bool(moving)) ++count[bin(s.c)];
+        if (range[moving].n == 0) continue;
+        Histogram& h = hist[moving];
         int nLayers = 0;
         for (float scale = 1.f;; scale *= 1.5f) {
             nLayers = 0;
             float cStart = 0;
             int last = -1;
-            for (int b = 0; b < bins; ++b) {
-                if (count[b] == 0) continue;
-                const float cb = cHi - (float(b) + 0.5f) * binW;
+            for (int b = 0; b < h.bins; ++b) {
+                if (h.count[b] == 0) continue;
+                const float cb = h.cHi - (float(b) + 0.5f) * h.binW;
                 const float spread = std::max(o.splitMin, o.splitScale * std::abs(cStart)) * scale;
-                const bool gap = last >= 0 && float(b - last - 1) * binW >= o.splitMin * scale;
+                const bool gap = last >= 0 && float(b - last - 1) * h.binW >= o.splitMin * scale;
                 if (last < 0 || cStart - cb > spread || gap) {
                     ++nLayers;
                     cStart = cb;
                 }
-                binLayer[b] = nLayers - 1;
+                h.binLayer[b] = nLayers - 1;
                 last = b;
             }
             if (int(layers.size()) + nLayers <= o.maxLayers || nLayers <= 1) break;
         }
-        const int base = int(layers.size());
-        layers.resize(base + nLayers);
-        for (int k = base; k < base + nLayers; ++k) layers[k].moving = bool(moving);
-        for (Gathered& s : g) {
-            if (s.moving != bool(moving)) continue;
-            s.layer = base + binLayer[bin(s.c)];
-            Layer& l = layers[s.layer];
-            ++l.count;
-            l.sumC += s.c;
-            l.sumMx += s.mx;
-            l.sumMy += s.my;
-            l.sumInvDepth += s.invDepth;
-            l.cMin = std::min(l.cMin, s.c);
-            l.cMax = std::max(l.cMax, s.c);
-        }
+        h.base = int(layers.size());
+        layers.resize(h.base + nLayers);
+        for (int k = h.base; k < h.base + nLayers; ++k) layers[k].moving = bool(moving);
+    }
+    for (Gathered& s : g) {
+        const Histogram& h = hist[s.moving];
+        s.layer = h.base + h.binLayer[h.bin(s.c)];
+        Layer& l = layers[s.layer];
+        ++l.count;
+        l.sumC += s.c;
+        l.sumMx += s.mx;
+        l.sumMy += s.my;
+        l.sumInvDepth += s.invDepth;
+        l.cMin = std::min(l.cMin, s.c);
+        l.cMax = std::max(l.cMax, s.c);
     }
     for (Layer& l : layers) {
         const double inv = 1.0 / std::max(1, l.count);
@@ -223,15 +246,16 @@ void resolveCells(Layer& l, float minWeight) {
     std::vector<uint8_t> alphaOk(cells, 0), radianceOk(cells, 0);
     for (int i = 0; i < cells; ++i) {
         const float* a = &l.acc[size_t(i) * as];
+        const float d = l.accD[i];
         float* c = &l.cell[size_t(i) * cs];
         c[cs - 1] = a[0] >= minWeight ? a[as - 1] / a[0] : l.c;
-        if (a[1] >= minWeight) {
-            c[0] = std::clamp(a[0] / a[1], 0.f, 1.f);
+        if (d >= minWeight) {
+            c[0] = std::clamp(a[0] / d, 0.f, 1.f);
             alphaOk[i] = 1;
         }
         int have = -1;
         for (int b = 0; b < bins; ++b) {
-            const float* ab = a + 2 + 4 * b;
+            const float* ab = a + 1 + 4 * b;
             if (ab[0] < minWeight) continue;
             const float inv = 1.f / ab[0];
             for (int ch = 0; ch < 3; ++ch) c[1 + 3 * b + ch] = ab[1 + ch] * inv;
@@ -241,10 +265,10 @@ void resolveCells(Layer& l, float minWeight) {
         radianceOk[i] = 1;
         // Empty time bins take the nearest bin that has samples.
         for (int b = 0; b < bins; ++b) {
-            if (a[2 + 4 * b] >= minWeight) continue;
+            if (a[1 + 4 * b] >= minWeight) continue;
             int best = have;
             for (int k = 0; k < bins; ++k)
-                if (a[2 + 4 * k] >= minWeight && std::abs(k - b) < std::abs(best - b)) best = k;
+                if (a[1 + 4 * k] >= minWeight && std::abs(k - b) < std::abs(best - b)) best = k;
             for (int ch = 0; ch < 3; ++ch) c[1 + 3 * b + ch] = c[1 + 3 * best + ch];
         }
     }
@@ -415,6 +439,7 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                 for (int y = ry0; y < ry1; ++y)
                     for (int x = rx0; x < rx1; ++x) expected += lf.count(size_t(y) * W + x);
                 g.reserve(expected);
+                SlopeRange range[2];  // of the still and the moving samples
                 for (int y = ry0; y < ry1; ++y)
                     for (int x = rx0; x < rx1; ++x) {
                         const size_t q = size_t(y) * W + x;
@@ -436,6 +461,7 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                             a.pixel = uint32_t(q);
                             a.surface = int8_t(s.surface());
                             a.layer = 0;
+                            range[a.moving].add(a.c);
                             g.push_back(a);
                         });
                     }
@@ -454,7 +480,7 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                     const Image3f* light = s.surface >= 0 ? in.surfaceLight[s.surface] : nullptr;
                     return light ? unpackRgb9e5(s.albedo) * (*light)[s.pixel] : unpackRgb9e5(s.radiance);
                 };
-                std::vector<Layer> layers = splitLayers(g, o);
+                std::vector<Layer> layers = splitLayers(g, range, o);
                 layerTotal += layers.size();
                 bool anyBlurred = false;
                 for (Layer& l : layers) {
@@ -494,6 +520,7 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                     l.gh = Y1 - Y0 + 2 * lm;
                     l.timeBins = l.moving ? kTimeBins : 1;
                     l.acc.assign(size_t(l.gw) * l.gh * l.accStride(), 0.f);
+                    l.accD.assign(size_t(l.gw) * l.gh, 0.f);
                 }
                 blurredTotal += anyBlurred ? 1 : 0;
                 // Splat: N and D at the layer's shear, W and the radiance at the sample's own.
@@ -503,7 +530,7 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                     for (int k = 0; k < s.layer; ++k) {
                         Layer& l = layers[k];
                         const int ci = l.cellIndex(l.sharpPosition(s));
-                        if (ci >= 0) l.acc[size_t(ci) * l.accStride() + 1] += 1.f;
+                        if (ci >= 0) l.accD[ci] += 1.f;
                     }
                     // Its own layer's N, D, W and radiance at its own trajectory's point.
                     Layer& l = layers[s.layer];
@@ -515,19 +542,23 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                     const int ci = l.cellIndex(own);
                     if (ci < 0) continue;
                     l.acc[size_t(ci) * l.accStride()] += 1.f;
-                    l.acc[size_t(ci) * l.accStride() + 1] += 1.f;
+                    l.accD[ci] += 1.f;
                     l.acc[size_t(ci + 1) * l.accStride() - 1] += s.c;
                     const Vec3f radiance = radianceOf(s);
-                    float* a = &l.acc[size_t(ci) * l.accStride() + 2 + 4 * l.timeBin(s.t)];
+                    float* a = &l.acc[size_t(ci) * l.accStride() + 1 + 4 * l.timeBin(s.t)];
                     a[0] += 1.f;
                     a[1] += radiance.x;
                     a[2] += radiance.y;
                     a[3] += radiance.z;
                 }
                 for (Layer& l : layers) {
-                    if (!l.sharp) smooth(l.acc, l.gw, l.gh, l.accStride(), l.sigma);
+                    if (!l.sharp) {
+                        smooth(l.acc, l.gw, l.gh, l.accStride(), l.sigma);
+                        smooth(l.accD, l.gw, l.gh, 1, l.sigma);
+                    }
                     resolveCells(l, l.sharp ? 0.5f : 0.05f);
                     l.acc = std::vector<float>();
+                    l.accD = std::vector<float>();
                     l.buildCovered();
                     l.rayReach = std::max({std::abs(l.cMin), std::abs(l.cMax), std::abs(l.rayC)}) +
                                  0.5f * std::sqrt(l.rayMx * l.rayMx + l.rayMy * l.rayMy);
