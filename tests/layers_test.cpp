@@ -177,6 +177,54 @@ TEST(Layers, AConstantLightFieldStaysConstantAndEmptyTilesGiveNoNaN) {
         }
 }
 
+TEST(Layers, OnlyPixelsWhoseRaysStraddleLayersTakeTheExtraRays) {
+    // A defocused disc (depth 1, slope +5 px) over a far wall (depth 10, slope -4 px), 16 samples
+    // a pixel, radiance varying so that more rays change a pixel's value. The extra rays
+    // (LayerOptions::mixedRays) may change only pixels near the disc's rim, which its layer's
+    // coverage and the wall's overlap; everywhere else the image is the one with 32 rays.
+    const int W = 128, H = 96;
+    ViewGeometry view;
+    view.width = W;
+    view.height = H;
+    view.focalPixels = 100;
+    view.apertureRadius = 0.1f;
+    view.focusDistance = 2.f;
+    LightFieldSamples lf(W, H);
+    const int stage = lf.addStage([&](size_t) { return 16u; });
+    std::mt19937 rng(9);
+    std::uniform_real_distribution<float> uni(0.f, 1.f);
+    auto rim = [](int x, int y) { return std::sqrt(float((x - 60) * (x - 60) + (y - 48) * (y - 48))); };
+    for (int y = 0; y < H; ++y)
+        for (int x = 0; x < W; ++x) {
+            LightFieldSample* run = lf.run(stage, size_t(y) * W + x);
+            const bool front = rim(x, y) < 24.f;
+            for (int k = 0; k < 16; ++k)
+                run[k] = LightFieldSample::pack({uni(rng), uni(rng)}, concentricDisc(uni(rng), uni(rng)), uni(rng),
+                                                front ? 1.f : 10.f, {0.f, 0.f}, Vec3f(1.f), Vec3f(0.2f + 0.6f * uni(rng)),
+                                                front ? 0 : 1);
+        }
+    filter::LayerOptions o32;
+    o32.mixedRays = 32;
+    filter::LayerStats stats32, stats64;
+    const Image3f a = filter::reconstructLayers(filter::LayerInput{lf, view, {}}, o32, &stats32);
+    const Image3f b = filter::reconstructLayers(filter::LayerInput{lf, view, {}}, filter::LayerOptions{}, &stats64);
+    EXPECT_EQ(stats32.straddlingPixels, 0.0);
+    EXPECT_GT(stats64.straddlingPixels, 0.05);
+    EXPECT_LT(stats64.straddlingPixels, 0.6);
+    int changed = 0;
+    for (int y = 0; y < H; ++y)
+        for (int x = 0; x < W; ++x) {
+            const float r = rim(x, y);
+            // Within reach of the rim: both slopes, the grids' Gaussian (3 x 2 px) and a cell.
+            if (std::abs(r - 24.f) <= 5.f + 4.f + 6.f + 2.f) {
+                changed += a(x, y) != b(x, y);
+                continue;
+            }
+            ASSERT_EQ(a(x, y), b(x, y)) << x << ", " << y << " at " << r << " px from the disc's centre";
+        }
+    EXPECT_GT(changed, 100);
+}
+
 namespace {
 
 /// A lit half-plane (x < 0 at depth 2) in front of nothing, under a thin lens focused at 4: its

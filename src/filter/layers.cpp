@@ -414,7 +414,7 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
             r = std::max(r, reach[size_t(y) * W + x]);
         }
 
-    std::atomic<uint64_t> gatheredTotal{0}, layerTotal{0}, blurredTotal{0};
+    std::atomic<uint64_t> gatheredTotal{0}, layerTotal{0}, blurredTotal{0}, straddlingTotal{0};
     const int apronTiles = (o.maxReach + T - 1) / T;
     const float pad = std::ceil(3.f * o.sigmaMax) + 2.f;
     parallelTiles(tilesX, tilesY, 1, [&](int tx0, int tx1, int ty0, int ty1) {
@@ -573,14 +573,16 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                 std::vector<Active> active;
                 // The rays' sequence before each pixel's shift: (j + 1) k_d modulo 1.
                 float kron[64][5];
-                const int rays = anyBlurred ? std::min(o.rays, 64) : 1;
-                for (int j = 0; j < rays; ++j)
+                const int rays = anyBlurred ? std::clamp(o.rays, 1, 64) : 1;
+                const int mixedRays = anyBlurred ? std::clamp(o.mixedRays, rays, 64) : 1;
+                for (int j = 0; j < mixedRays; ++j)
                     for (int d = 0; d < 5; ++d) {
                         const double v = double(j + 1) * kKronecker[d];
                         kron[j][d] = float(v - std::floor(v));
                     }
 
                 // Reconstruction rays, composited front to back.
+                uint64_t straddling = 0;
                 for (int y = Y0; y < Y1; ++y)
                     for (int x = X0; x < X1; ++x) {
                         // The rays: a 5D Kronecker sequence (the generalised golden ratio's powers,
@@ -621,7 +623,11 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                                 if (trans < 1e-4f) break;
                             }
                         }
-                        const int pixelRays = sameForEveryRay ? 1 : rays;
+                        int pixelRays = sameForEveryRay ? 1 : rays;
+                        // Whether the rays so far straddle layers: one ended on another layer
+                        // than the first ray, or took part of a layer's coverage.
+                        int firstLayer = -2;
+                        bool straddles = false;
                         Vec3f sum(0.f);
                         for (int j = 0; j < pixelRays; ++j) {
                             float q[5];
@@ -635,6 +641,7 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                             const float dt = (anyBlurred ? q[4] : 0.5f) - 0.5f;
                             Vec3f c(0.f);
                             float trans = 1.f;
+                            int hitLayer = -1;
                             for (const Active& a : active) {
                                 const Layer& l = *a.layer;
                                 Lookup v;
@@ -652,7 +659,20 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                                 }
                                 c += v.premultiplied * trans;
                                 trans *= 1.f - v.alpha;
+                                if (v.alpha > 0.f) {
+                                    if (hitLayer < 0) hitLayer = int(&a - active.data());
+                                    straddles |= v.alpha < 1.f - 1e-4f;
+                                }
                                 if (trans < 1e-4f) break;
+                            }
+                            straddles |= firstLayer != -2 && hitLayer != firstLayer;
+                            if (firstLayer == -2) firstLayer = hitLayer;
+                            // A pixel whose rays straddle layers (a defocused or moving
+                            // silhouette) takes the rest of the sequence: there the rays'
+                            // own noise is what remains (docs/layers.md).
+                            if (j + 1 == rays && straddles && mixedRays > rays) {
+                                pixelRays = mixedRays;
+                                ++straddling;
                             }
                             // Light the layers leave uncovered (a hole no sample saw) is taken as
                             // the mean of what they cover.
@@ -660,12 +680,14 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                         }
                         out(x, y) = sum / float(pixelRays);
                     }
+                straddlingTotal += straddling;
             }
     });
     if (stats) {
         stats->gatheredPerPixel = double(gatheredTotal) / double(std::max<size_t>(1, size_t(W) * H));
         stats->layersPerTile = double(layerTotal) / double(size_t(tilesX) * tilesY);
         stats->blurredTiles = double(blurredTotal) / double(size_t(tilesX) * tilesY);
+        stats->straddlingPixels = double(straddlingTotal) / double(std::max<size_t>(1, size_t(W) * H));
     }
     return out;
 }

@@ -36,7 +36,10 @@
 //    narrowed disc have the second moment of the true disc: C += T alpha L, T *= 1 - alpha.
 //    Light the layers leave uncovered (a hole no sample saw) is the mean of what they cover.
 //    Where every layer of the tile is sharp, one ray at the pixel gives the same: the pixel's
-//    own samples composited by surface, as without layers.
+//    own samples composited by surface, as without layers. A pixel whose 32 rays straddle
+//    layers (ended on different ones, or on a layer's partial coverage: a defocused or moving
+//    silhouette) takes the sequence on to 64 rays: there the rays' own noise was a tenth of
+//    the error (MC 16 spp on bunny at 512x512: the mixed pixels' relMSE 0.00136 -> 0.00121).
 //
 // The radiance a sample carries is its surface's light as the method filtered it (AAF's or
 // MAAF's filtered direct and indirect light of the sample's surface in its pixel, times the
@@ -60,6 +63,7 @@ struct LayerOptions {
     float splitMin = 0.5f, splitScale = 0.15f;  // a layer's slopes spread at most max(splitMin, splitScale |c|)
     int maxLayers = 8;
     int rays = 32;      // reconstruction rays per pixel where a tile has a blurred layer (at most 64)
+    int mixedRays = 64; // ... where the first `rays` straddle layers (at most 64)
     uint32_t seed = 0;  // of the reconstruction rays
 };
 
@@ -76,6 +80,7 @@ struct LayerStats {
     double gatheredPerPixel = 0;  // samples a tile read, per pixel of the image
     double layersPerTile = 0;
     double blurredTiles = 0;      // fraction of tiles with a reprojected (blurred) layer
+    double straddlingPixels = 0;  // fraction of pixels whose first rays straddled layers (and took mixedRays)
 };
 
 /// The reflected radiance (no emission) of every pixel, reconstructed from the light field.

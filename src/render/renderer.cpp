@@ -112,6 +112,7 @@ Image3f reconstructFromLayers(const MethodContext& ctx,
     result.extra.emplace_back("layers_gathered_per_pixel", stats.gatheredPerPixel);
     result.extra.emplace_back("layers_per_tile", stats.layersPerTile);
     result.extra.emplace_back("layers_blurred_tiles", stats.blurredTiles);
+    result.extra.emplace_back("layers_straddling_pixels", stats.straddlingPixels);
     return color;
 }
 
