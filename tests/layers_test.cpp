@@ -33,6 +33,17 @@ render::RenderResult renderJson(const std::string& json, render::RenderOptions o
     return render::render(s, o);
 }
 
+/// A W x H view of focal length 100 px under a lens of radius 0.1 focused at 2.
+ViewGeometry wideLensView(int W, int H) {
+    ViewGeometry view;
+    view.width = W;
+    view.height = H;
+    view.focalPixels = 100;
+    view.apertureRadius = 0.1f;
+    view.focusDistance = 2.f;
+    return view;
+}
+
 /// The share of the unit disc with u_x > d: a circular segment.
 double discShareBeyond(double d) {
     if (d <= -1) return 1;
@@ -141,12 +152,7 @@ TEST(Layers, AConstantLightFieldStaysConstantAndEmptyTilesGiveNoNaN) {
     // Two depths under a wide lens (slopes +10 and -4 px) and a moving third, every sample of
     // radiance 0.5; the pixels right of x = 128 have no samples at all (two whole 64-px tiles).
     const int W = 192, H = 80;
-    ViewGeometry view;
-    view.width = W;
-    view.height = H;
-    view.focalPixels = 100;
-    view.apertureRadius = 0.1f;
-    view.focusDistance = 2.f;
+    const ViewGeometry view = wideLensView(W, H);
     LightFieldSamples lf(W, H);
     const int stage = lf.addStage([&](size_t p) { return int(p % W) < 128 ? 16u : 0u; });
     std::mt19937 rng(5);
@@ -183,12 +189,7 @@ TEST(Layers, OnlyPixelsWhoseRaysStraddleLayersTakeTheExtraRays) {
     // (LayerOptions::mixedRays) may change only pixels near the disc's rim, which its layer's
     // coverage and the wall's overlap; everywhere else the image is the one with 32 rays.
     const int W = 128, H = 96;
-    ViewGeometry view;
-    view.width = W;
-    view.height = H;
-    view.focalPixels = 100;
-    view.apertureRadius = 0.1f;
-    view.focusDistance = 2.f;
+    const ViewGeometry view = wideLensView(W, H);
     LightFieldSamples lf(W, H);
     const int stage = lf.addStage([&](size_t) { return 16u; });
     std::mt19937 rng(9);
