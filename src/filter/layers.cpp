@@ -344,10 +344,11 @@ struct Bilinear {
     const float fx = std::clamp(p.x - float(l.gx0) - 0.5f, 0.f, float(l.gw - 1));
     const float fy = std::clamp(p.y - float(l.gy0) - 0.5f, 0.f, float(l.gh - 1));
     const int i0 = std::min(int(fx), std::max(0, l.gw - 2)), j0 = std::min(int(fy), std::max(0, l.gh - 2));
-    const int i1 = std::min(i0 + 1, l.gw - 1), j1 = std::min(j0 + 1, l.gh - 1);
     const float ax = fx - float(i0), ay = fy - float(j0);
-    return {{j0 * l.gw + i0, j0 * l.gw + i1, j1 * l.gw + i0, j1 * l.gw + i1},
-            {(1 - ax) * (1 - ay), ax * (1 - ay), (1 - ax) * ay, ax * ay}};
+    // A blurred layer's grid is at least 3 cells a side (its tile and a margin of one or more),
+    // so the next cell along either axis is always inside it.
+    const int c00 = j0 * l.gw + i0;
+    return {{c00, c00 + 1, c00 + l.gw, c00 + l.gw + 1}, {(1 - ax) * (1 - ay), ax * (1 - ay), (1 - ax) * ay, ax * ay}};
 }
 /// The layer's own slope at p alone (the rays' fixed-point step), as lookup(l, p, t).slope.
 [[gnu::always_inline]] inline float lookupSlope(const Layer& l, Vec2f p) {
