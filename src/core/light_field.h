@@ -36,8 +36,8 @@ inline uint32_t packRgb9e5(const Vec3f& c) {
     const float m = std::max({r, g, b});
     if (!(m > 0.f)) return 0;
     // The shared exponent e (biased by 15): mantissa = v / 2^(e - 15 - 9), at most 511. floor(log2 m)
-    // is m's own binary exponent (read from its bits: std::log2 rounded up to the next integer
-    // just below powers of two, and with std::ldexp was a third of recording a sample).
+    // is m's own binary exponent, read from its bits, and 2^k is built from bits too: std::log2
+    // and std::ldexp were library calls for every recorded sample (the same bytes, layers_test).
     auto pow2 = [](int k) { return std::bit_cast<float>(uint32_t(k + 127) << 23); };  // 2^k, |k| < 127
     int e = std::max(-16, int((std::bit_cast<uint32_t>(m) >> 23) & 255u) - 127) + 16;
     float scale = pow2(24 - e);

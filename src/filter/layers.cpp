@@ -147,13 +147,13 @@ std::vector<Layer> splitLayers(std::vector<Gathered>& g, const SlopeRange (&rang
         h.binLayer.assign(h.bins, -1);
     }
     for (const Gathered& s : g) {
-        const Histogram& h = hist[s.moving];
-        ++hist[s.moving].count[h.bin(s.c)];
+        Histogram& h = hist[s.moving];
+        ++h.count[h.bin(s.c)];
     }
     std::vector<Layer> layers;
     for (int moving = 0; moving < 2; ++moving) {
-        if (range[moving].n == 0) continue;
         Histogram& h = hist[moving];
+        if (h.bins == 0) continue;  // no samples of this class
         int nLayers = 0;
         for (float scale = 1.f;; scale *= 1.5f) {
             nLayers = 0;
@@ -345,8 +345,8 @@ struct Bilinear {
     const float fy = std::clamp(p.y - float(l.gy0) - 0.5f, 0.f, float(l.gh - 1));
     const int i0 = std::min(int(fx), std::max(0, l.gw - 2)), j0 = std::min(int(fy), std::max(0, l.gh - 2));
     const float ax = fx - float(i0), ay = fy - float(j0);
-    // A blurred layer's grid is at least 3 cells a side (its tile and a margin of one or more),
-    // so the next cell along either axis is always inside it.
+    // A blurred layer's grid is at least 7 cells a side (its tile and a margin of at least
+    // ceil(3 sigma) + 1 = 3 cells each way), so the next cell along either axis is inside it.
     const int c00 = j0 * l.gw + i0;
     return {{c00, c00 + 1, c00 + l.gw, c00 + l.gw + 1}, {(1 - ax) * (1 - ay), ax * (1 - ay), (1 - ax) * ay, ax * ay}};
 }
