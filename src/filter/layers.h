@@ -32,8 +32,10 @@
 //    shifted per pixel, so that pixel, lens and shutter are stratified jointly. Front to back, a
 //    ray takes each layer's alpha and premultiplied radiance at its shear, with the slope of the
 //    surface it finds there (one fixed-point step: a slanted floor's slope changes across the
-//    tile), narrowed so that the grid's own blur (cells, Gaussian, bilinear lookup) and the
-//    narrowed disc have the second moment of the true disc: C += T alpha L, T *= 1 - alpha.
+//    tile), shaped so that the grid's own blur (cells, Gaussian, bilinear lookup) over the
+//    rays' disc (segment) gives the true disc's (segment's) edge profile as nearly as a
+//    near-Gaussian allows (rays drawn towards the rim: layers.cpp, Shaped): C += T alpha L, T *=
+//    1 - alpha.
 //    Light the layers leave uncovered (a hole no sample saw) is the mean of what they cover.
 //    Where every layer of the tile is sharp, one ray at the pixel gives the same: the pixel's
 //    own samples composited by surface, as without layers. A pixel whose 32 rays straddle
