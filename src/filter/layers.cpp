@@ -646,6 +646,14 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                     Lookup value;
                 };
                 std::vector<Active> active;
+                // A reconstruction ray: its point, and what the layers in front gave it so far.
+                struct RayState {
+                    Vec2f u;
+                    float u2, px, py, dt, trans;
+                    Vec3f c;
+                    int hit;
+                };
+                RayState ray[64];
                 // The rays' sequence before each pixel's shift: (j + 1) k_d modulo 1.
                 float kron[64][5];
                 const int rays = anyBlurred ? std::clamp(o.rays, 1, 64) : 1;
@@ -699,64 +707,86 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                             }
                         }
                         int pixelRays = sameForEveryRay ? 1 : rays;
-                        // Whether the rays so far straddle layers: one ended on another layer
-                        // than the first ray, or took part of a layer's coverage.
-                        int firstLayer = -2;
-                        bool straddles = false;
-                        Vec3f sum(0.f);
-                        for (int j = 0; j < pixelRays; ++j) {
-                            float q[5];
-                            for (int d = 0; d < 5; ++d) {
-                                const float v = shift[d] + kron[j][d];
-                                q[d] = v >= 1.f ? v - 1.f : v;
+                        // The rays are traced a layer at a time, each layer over all the rays it
+                        // has not yet stopped (transmittance below 1e-4): per ray the same
+                        // front-to-back steps, so the same image as ray after ray, with the
+                        // layer's branches and constants taken once per layer instead of per ray.
+                        // Whether the rays straddle layers: one ended on another layer than the
+                        // first ray, or took part of a layer's coverage.
+                        bool partial = false;
+                        auto trace = [&](int j0, int j1) {
+                            for (int j = j0; j < j1; ++j) {
+                                float q[5];
+                                for (int d = 0; d < 5; ++d) {
+                                    const float v = shift[d] + kron[j][d];
+                                    q[d] = v >= 1.f ? v - 1.f : v;
+                                }
+                                RayState& r = ray[j];
+                                r.u = anyBlurred ? concentricDisc(q[2], q[3]) : Vec2f{0, 0};
+                                r.u2 = r.u.x * r.u.x + r.u.y * r.u.y;
+                                r.px = float(x) + (anyBlurred ? q[0] : 0.5f);
+                                r.py = float(y) + (anyBlurred ? q[1] : 0.5f);
+                                r.dt = (anyBlurred ? q[4] : 0.5f) - 0.5f;
+                                r.c = Vec3f(0.f);
+                                r.trans = 1.f;
+                                r.hit = -1;
                             }
-                            const Vec2f u = anyBlurred ? concentricDisc(q[2], q[3]) : Vec2f{0, 0};
-                            const float u2 = u.x * u.x + u.y * u.y;
-                            const float px = float(x) + (anyBlurred ? q[0] : 0.5f);
-                            const float py = float(y) + (anyBlurred ? q[1] : 0.5f);
-                            const float dt = (anyBlurred ? q[4] : 0.5f) - 0.5f;
-                            Vec3f c(0.f);
-                            float trans = 1.f;
-                            int hitLayer = -1;
                             for (const Active& a : active) {
                                 const Layer& l = *a.layer;
-                                Lookup v;
+                                const int index = int(&a - active.data());
+                                auto take = [&](RayState& r, const Lookup& v) {
+                                    r.c += v.premultiplied * r.trans;
+                                    r.trans *= 1.f - v.alpha;
+                                    if (v.alpha > 0.f) {
+                                        if (r.hit < 0) r.hit = index;
+                                        partial |= v.alpha < 1.f - 1e-4f;
+                                    }
+                                };
                                 if (a.fixed) {
-                                    v = a.value;
+                                    for (int j = j0; j < j1; ++j)
+                                        if (ray[j].trans >= 1e-4f) take(ray[j], a.value);
                                 } else if (l.sharp) {  // a sharp layer is its pixels' own samples: the ray's pixel
-                                    v = lookup(l, {float(x) + 0.5f, float(y) + 0.5f}, dt + 0.5f);
+                                    for (int j = j0; j < j1; ++j)
+                                        if (ray[j].trans >= 1e-4f)
+                                            take(ray[j], lookup(l, {float(x) + 0.5f, float(y) + 0.5f}, ray[j].dt + 0.5f));
                                 } else {
                                     // The layer's shear, then the slope of the surface it finds
                                     // there (one fixed-point step), shaped by the grid's blur.
-                                    const float st = dt * (1.f + l.rayT2 * 4.f * dt * dt);
-                                    const Vec2f mo{l.rayMx * st, l.rayMy * st};
-                                    float cRay = l.rayC + l.rayC2 * u2;
-                                    if (l.cMax - l.cMin >= kSlopeSpread) {
-                                        const Shaped sh = l.shearAt(lookupSlope(l, {px + cRay * u.x - mo.x, py - cRay * u.y - mo.y}));
-                                        cRay = sh.a + sh.b * u2;
+                                    const bool follow = l.cMax - l.cMin >= kSlopeSpread;
+                                    for (int j = j0; j < j1; ++j) {
+                                        RayState& r = ray[j];
+                                        if (r.trans < 1e-4f) continue;
+                                        const float st = r.dt * (1.f + l.rayT2 * 4.f * r.dt * r.dt);
+                                        const Vec2f mo{l.rayMx * st, l.rayMy * st};
+                                        float cRay = l.rayC + l.rayC2 * r.u2;
+                                        if (follow) {
+                                            const Shaped sh = l.shearAt(lookupSlope(l, {r.px + cRay * r.u.x - mo.x, r.py - cRay * r.u.y - mo.y}));
+                                            cRay = sh.a + sh.b * r.u2;
+                                        }
+                                        take(r, lookup(l, {r.px + cRay * r.u.x - mo.x, r.py - cRay * r.u.y - mo.y}, r.dt + 0.5f));
                                     }
-                                    v = lookup(l, {px + cRay * u.x - mo.x, py - cRay * u.y - mo.y}, dt + 0.5f);
                                 }
-                                c += v.premultiplied * trans;
-                                trans *= 1.f - v.alpha;
-                                if (v.alpha > 0.f) {
-                                    if (hitLayer < 0) hitLayer = int(&a - active.data());
-                                    straddles |= v.alpha < 1.f - 1e-4f;
-                                }
-                                if (trans < 1e-4f) break;
                             }
-                            straddles |= firstLayer != -2 && hitLayer != firstLayer;
-                            if (firstLayer == -2) firstLayer = hitLayer;
-                            // A pixel whose rays straddle layers (a defocused or moving
-                            // silhouette) takes the rest of the sequence: there the rays'
-                            // own noise is what remains (docs/layers.md).
-                            if (j + 1 == rays && straddles && mixedRays > rays) {
+                        };
+                        trace(0, pixelRays);
+                        // A pixel whose rays straddle layers (a defocused or moving silhouette)
+                        // takes the rest of the sequence: there the rays' own noise is what
+                        // remains (docs/layers.md).
+                        if (pixelRays == rays && mixedRays > rays) {
+                            bool straddles = partial;
+                            for (int j = 1; j < rays && !straddles; ++j) straddles = ray[j].hit != ray[0].hit;
+                            if (straddles) {
+                                trace(rays, mixedRays);
                                 pixelRays = mixedRays;
                                 ++straddling;
                             }
-                            // Light the layers leave uncovered (a hole no sample saw) is taken as
-                            // the mean of what they cover.
-                            sum += trans > 1e-4f && trans < 1.f ? c / (1.f - trans) : c;
+                        }
+                        // Light the layers leave uncovered (a hole no sample saw) is taken as
+                        // the mean of what they cover.
+                        Vec3f sum(0.f);
+                        for (int j = 0; j < pixelRays; ++j) {
+                            const RayState& r = ray[j];
+                            sum += r.trans > 1e-4f && r.trans < 1.f ? r.c / (1.f - r.trans) : r.c;
                         }
                         out(x, y) = sum / float(pixelRays);
                     }
