@@ -295,7 +295,8 @@ namespace {
 /// `spp` samples, with and without layers, against its shutter average: a pixel is the strip's
 /// radiance times the share of the shutter the strip covers it.
 ColumnErrors movingStripErrors(float velocity, int spp) {
-    std::string moving = R"({
+    auto strip = [](float v) {
+        std::string json = R"({
       "camera": {"position": [0, 0, 0], "look_at": [0, 0, -1], "up": [0, 1, 0], "fov_y": 10, "resolution": [64, 16]},
       "materials": {"white": {"albedo": [0.8, 0.8, 0.8]}},
       "lights": [{"type": "parallelogram", "corner": [-100, -100, 60], "edge1": [0, 200, 0], "edge2": [200, 0, 0], "radiance": [1, 1, 1]}],
@@ -303,7 +304,9 @@ ColumnErrors movingStripErrors(float velocity, int spp) {
                    "velocity": [VELOCITY, 0, 0]}],
       "render": {"spp": 16, "seed": 11, "indirect": false}
     })";
-    moving.replace(moving.find("VELOCITY"), 8, std::to_string(velocity));
+        return json.replace(json.find("VELOCITY"), 8, std::to_string(v));
+    };
+    const std::string moving = strip(velocity);
     render::RenderOptions o;
     o.method = "mc";
     o.spp = spp;
@@ -311,10 +314,8 @@ ColumnErrors movingStripErrors(float velocity, int spp) {
     const render::RenderResult on = renderJson(moving, o);
     o.layers = "off";
     const render::RenderResult off = renderJson(moving, o);
-    std::string still = moving;
-    still.replace(still.find("\"velocity\""), std::string("\"velocity\": [").size() + std::to_string(velocity).size(), "\"velocity\": [0");
     o.spp = 64;
-    const render::RenderResult flat = renderJson(still, o);
+    const render::RenderResult flat = renderJson(strip(0.f), o);
     const render::Camera cam(parse(moving).camera);
     double radiance = 0;  // the still strip's, at its middle column
     const float mid = cam.project({-0.3f, 0.f, -4.f}).x;

@@ -105,6 +105,9 @@ struct Layer {
     static constexpr int kShearSteps = 8;
     float shearFrom = 0, shearScale = 0;  // the table's index: (c - shearFrom) shearScale
     Shaped shearTable[kShearSteps + 1];
+    /// Whether the layer's slopes spread so far that its rays take the slope of the surface
+    /// they find (from shearTable) rather than the layer's.
+    bool followsSlope() const { return cMax - cMin >= kSlopeSpread; }
     /// The shaped lens shear (A, B) of the slope c.
     Shaped shear(float c) const {
         if (sqr(c) <= 4.f * gridBlur) return {};
@@ -573,7 +576,7 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                         l.sigma = std::clamp(std::max(o.sigmaScale * std::abs(l.c), 0.5f * spread), o.sigmaMin, o.sigmaMax);
                         const float gridBlur = cellBlur + sqr(l.sigma);
                         l.gridBlur = gridBlur;
-                        if (l.cMax - l.cMin >= kSlopeSpread) l.buildShearTable();
+                        if (l.followsSlope()) l.buildShearTable();
                         if (0.25f * sqr(l.c) >= gridBlur) {
                             const Shaped sh = l.shear(l.c);
                             l.rayC = sh.a, l.rayC2 = sh.b;
@@ -752,7 +755,7 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                                 } else {
                                     // The layer's shear, then the slope of the surface it finds
                                     // there (one fixed-point step), shaped by the grid's blur.
-                                    const bool follow = l.cMax - l.cMin >= kSlopeSpread;
+                                    const bool follow = l.followsSlope();
                                     for (int j = j0; j < j1; ++j) {
                                         RayState& r = ray[j];
                                         if (r.trans < 1e-4f) continue;
