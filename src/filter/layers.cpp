@@ -97,7 +97,7 @@ struct Layer {
     // The rays' shear, shaped by the grid's own blur (Shaped): a ray at lens point u (unit disc)
     // is sheared by (rayC + rayC2 |u|^2) u, one at time t by (1 + rayT2 (2 s)^2) s rayM, s = t -
     // 1/2. A ray that takes the slope c of the surface it finds is sheared by (A(c) + B(c)
-    // |u|^2) u, from a table of kShearSteps steps over the layer's slopes (shearAt; computing
+    // |u|^2) u, linear in a table of kShearSteps steps over the layer's slopes (traceBlurred; computing
     // them per ray, a division and the table's lookup, measured 11-19% more time in the stage
     // than the narrowed disc's square root before it, three rounds on conference and cornell).
     float rayC = 0, rayC2 = 0, rayMx = 0, rayMy = 0, rayT2 = 0;
@@ -119,14 +119,6 @@ struct Layer {
         shearFrom = cMin;
         shearScale = step > 0 ? 1.f / step : 0.f;
         for (int i = 0; i <= kShearSteps; ++i) shearTable[i] = shear(cMin + step * float(i));
-    }
-    Shaped shearAt(float c) const {
-        const float at = std::clamp((c - shearFrom) * shearScale, 0.f, float(kShearSteps) - 1e-3f);
-        const int i = int(at);
-        const float f = at - float(i);
-        const Shaped& p = shearTable[i];
-        const Shaped& q = shearTable[i + 1];
-        return {p.a + f * (q.a - p.a), p.b + f * (q.b - p.b)};
     }
     bool sharp = true;
     float sigma = 0;
@@ -401,62 +393,130 @@ void resolveCells(Layer& l, float minWeight) {
     }
 }
 
-/// Alpha, premultiplied radiance and the layer's own slope at sharp-image position p and shutter
-/// time t: bilinear between cell centres (at +1/2) for a blurred layer, the cell for a sharp
-/// one; linear in time between the time bins' centres.
+/// Alpha and premultiplied radiance of a sharp layer at pixel (x, y) and shutter time t (see
+/// lookupSharp; a blurred layer's are read by traceBlurred).
 struct Lookup {
     float alpha = 0;
     Vec3f premultiplied{0.f};
-    float slope = 0;
 };
-/// The bilinear cells and weights of a blurred layer's lookup at p (see lookup()).
+/// The bilinear cells and weights of a blurred layer's lookup at sharp-image position p: between
+/// cell centres (at +1/2).
 struct Bilinear {
     int cell[4];
     float w[4];
 };
+/// std::clamp and std::min by value: the same results, and no references for the SIMD loops'
+/// if-conversion to trip on (traceBlurred).
+[[gnu::always_inline]] inline float clampValue(float v, float lo, float hi) { return v < lo ? lo : hi < v ? hi : v; }
+[[gnu::always_inline]] inline int minValue(int a, int b) { return b < a ? b : a; }
 [[gnu::always_inline]] inline Bilinear bilinear(const Layer& l, Vec2f p) {
-    const float fx = std::clamp(p.x - float(l.gx0) - 0.5f, 0.f, float(l.gw - 1));
-    const float fy = std::clamp(p.y - float(l.gy0) - 0.5f, 0.f, float(l.gh - 1));
-    const int i0 = std::min(int(fx), std::max(0, l.gw - 2)), j0 = std::min(int(fy), std::max(0, l.gh - 2));
+    const float fx = clampValue(p.x - float(l.gx0) - 0.5f, 0.f, float(l.gw - 1));
+    const float fy = clampValue(p.y - float(l.gy0) - 0.5f, 0.f, float(l.gh - 1));
+    const int i0 = minValue(int(fx), std::max(0, l.gw - 2)), j0 = minValue(int(fy), std::max(0, l.gh - 2));
     const float ax = fx - float(i0), ay = fy - float(j0);
     // A blurred layer's grid is at least 7 cells a side (its tile and a margin of at least
     // ceil(3 sigma) + 1 = 3 cells each way), so the next cell along either axis is inside it.
     const int c00 = j0 * l.gw + i0;
     return {{c00, c00 + 1, c00 + l.gw, c00 + l.gw + 1}, {(1 - ax) * (1 - ay), ax * (1 - ay), (1 - ax) * ay, ax * ay}};
 }
-/// The layer's own slope at p alone (the rays' fixed-point step), as lookup(l, p, t).slope.
-[[gnu::always_inline]] inline float lookupSlope(const Layer& l, Vec2f p) {
+/// A sharp layer's cell of pixel (x, y) at shutter time t: linear in time between the time
+/// bins' centres.
+Lookup lookupSharp(const Layer& l, int x, int y, float t) {
     const int cs = l.cellStride();
-    const Bilinear b = bilinear(l, p);
-    float slope = 0;
-    for (int k = 0; k < 4; ++k) slope += b.w[k] * l.cell[size_t(b.cell[k]) * cs + cs - 1];
-    return slope;
-}
-[[gnu::always_inline]] inline Lookup lookup(const Layer& l, Vec2f p, float t) {
-    const int cs = l.cellStride();
-    Lookup out;
     const float tb = std::clamp(t * float(l.timeBins) - 0.5f, 0.f, float(l.timeBins - 1));
     const int b0 = std::min(int(tb), l.timeBins - 1), b1 = std::min(b0 + 1, l.timeBins - 1);
     const float at = tb - float(b0);
-    auto accumulate = [&](int cellIndex, float w) {
-        const float* c = &l.cell[size_t(cellIndex) * cs];
-        out.alpha += w * c[0];
-        out.slope += w * c[cs - 1];
-        const float* r0 = c + 1 + 3 * b0;
-        if (b1 == b0) {  // a still layer (one bin), or the last bin's half
-            out.premultiplied += Vec3f(r0[0], r0[1], r0[2]) * w;
-            return;
+    const float* c = &l.cell[(size_t(y - l.gy0) * l.gw + size_t(x - l.gx0)) * cs];
+    const float* r0 = c + 1 + 3 * b0;
+    if (b1 == b0)  // a still layer (one bin), or the last bin's half
+        return {c[0], Vec3f(r0[0], r0[1], r0[2])};
+    const float* r1 = c + 1 + 3 * b1;
+    return {c[0], Vec3f(r0[0], r0[1], r0[2]) * (1.f - at) + Vec3f(r1[0], r1[1], r1[2]) * at};
+}
+
+/// A pixel's reconstruction rays, a structure of arrays (a still blurred layer's step is a SIMD
+/// loop over them, traceStill): each ray's film point, lens point u (u2 = |u|^2) and shutter
+/// offset dt = t - 1/2, and what the layers in front gave it so far (premultiplied light,
+/// transmittance, the first layer that covered it, -1 none).
+struct Rays {
+    static constexpr int kMax = 64;
+    alignas(64) float ux[kMax], uy[kMax], u2[kMax], px[kMax], py[kMax], dt[kMax], trans[kMax];
+    alignas(64) float cr[kMax], cg[kMax], cb[kMax];
+    alignas(64) int hit[kMax];
+};
+
+/// Rays [j0, j1) through a blurred layer (the `index`-th a pixel's rays see): the layer's lens
+/// and shutter shear, then (kFollow) the slope of the surface found there, shaped by the grid's
+/// blur, and the layer's alpha and premultiplied light there (kMoving: between its two nearest
+/// time bins) composited under what is in front, C += T alpha L, T *= 1 - alpha, for the rays
+/// not yet stopped (T >= 1e-4). Per ray the arithmetic of the scalar loop before (one ray after
+/// another, docs/layers.md), in the same order, as one SIMD loop: every lane is computed, and a stopped ray's
+/// results are not stored. Returns whether a ray took part of the layer's coverage.
+template <bool kFollow, bool kMoving>
+bool traceBlurred(const Layer& l, int index, Rays& ray, int j0, int j1) {
+    const int cs = l.cellStride(), bins = l.timeBins;
+    const float* cell = l.cell.data();
+    const Shaped* table = l.shearTable;
+    int partial = 0;
+#pragma omp simd reduction(| : partial)
+    for (int j = j0; j < j1; ++j) {
+        const float dt = ray.dt[j];
+        const float st = dt * (1.f + l.rayT2 * 4.f * dt * dt);
+        const float mox = l.rayMx * st, moy = l.rayMy * st;
+        float cRay = l.rayC + l.rayC2 * ray.u2[j];
+        if constexpr (kFollow) {
+            const Bilinear b = bilinear(l, {ray.px[j] + cRay * ray.ux[j] - mox, ray.py[j] - cRay * ray.uy[j] - moy});
+            float slope = 0;
+#pragma GCC unroll 4
+            for (int k = 0; k < 4; ++k) slope += b.w[k] * cell[b.cell[k] * cs + cs - 1];
+            const float at = clampValue((slope - l.shearFrom) * l.shearScale, 0.f, float(Layer::kShearSteps) - 1e-3f);
+            const int i = int(at);
+            const float f = at - float(i);
+            const float sa = table[i].a + f * (table[i + 1].a - table[i].a);
+            const float sb = table[i].b + f * (table[i + 1].b - table[i].b);
+            cRay = sa + sb * ray.u2[j];
         }
-        const float* r1 = c + 1 + 3 * b1;
-        out.premultiplied += Vec3f(r0[0], r0[1], r0[2]) * (w * (1.f - at)) + Vec3f(r1[0], r1[1], r1[2]) * (w * at);
-    };
-    if (l.sharp) {
-        accumulate((int(std::floor(p.y)) - l.gy0) * l.gw + (int(std::floor(p.x)) - l.gx0), 1.f);
-        return out;
+        const Bilinear b = bilinear(l, {ray.px[j] + cRay * ray.ux[j] - mox, ray.py[j] - cRay * ray.uy[j] - moy});
+        // Linear in time between the time bins' centres (one bin for a still layer, or the last
+        // bin's half).
+        int b0 = 0, b1 = 0;
+        float at = 0;
+        if constexpr (kMoving) {
+            const float tb = clampValue((dt + 0.5f) * float(bins) - 0.5f, 0.f, float(bins - 1));
+            b0 = minValue(int(tb), bins - 1);
+            b1 = minValue(b0 + 1, bins - 1);
+            at = tb - float(b0);
+        }
+        float alpha = 0, r = 0, g = 0, bl = 0;
+#pragma GCC unroll 4  // (an inner loop would keep the outer one from vectorising)
+        for (int k = 0; k < 4; ++k) {
+            const int c = b.cell[k] * cs;  // indices from one base: gathers
+            const float w = b.w[k];
+            alpha += w * cell[c];
+            const int c0 = c + 1 + 3 * b0;
+            if constexpr (kMoving) {
+                const int c1 = c + 1 + 3 * b1;
+                const bool one = b1 == b0;
+                r = one ? r + cell[c0] * w : r + (cell[c0] * (w * (1.f - at)) + cell[c1] * (w * at));
+                g = one ? g + cell[c0 + 1] * w : g + (cell[c0 + 1] * (w * (1.f - at)) + cell[c1 + 1] * (w * at));
+                bl = one ? bl + cell[c0 + 2] * w : bl + (cell[c0 + 2] * (w * (1.f - at)) + cell[c1 + 2] * (w * at));
+            } else {
+                r += cell[c0] * w;
+                g += cell[c0 + 1] * w;
+                bl += cell[c0 + 2] * w;
+            }
+        }
+        // Selects, not branches, so that the loop vectorises.
+        const float t = ray.trans[j];
+        const bool live = t >= 1e-4f, covers = live && alpha > 0.f;
+        ray.cr[j] = live ? ray.cr[j] + r * t : ray.cr[j];
+        ray.cg[j] = live ? ray.cg[j] + g * t : ray.cg[j];
+        ray.cb[j] = live ? ray.cb[j] + bl * t : ray.cb[j];
+        ray.trans[j] = live ? t * (1.f - alpha) : t;
+        ray.hit[j] = covers && ray.hit[j] < 0 ? index : ray.hit[j];
+        partial |= covers && alpha < 1.f - 1e-4f ? 1 : 0;
     }
-    const Bilinear b = bilinear(l, p);
-    for (int k = 0; k < 4; ++k) accumulate(b.cell[k], b.w[k]);
-    return out;
+    return partial != 0;
 }
 
 }  // namespace
@@ -649,14 +709,7 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                     Lookup value;
                 };
                 std::vector<Active> active;
-                // A reconstruction ray: its point, and what the layers in front gave it so far.
-                struct RayState {
-                    Vec2f u;
-                    float u2, px, py, dt, trans;
-                    Vec3f c;
-                    int hit;
-                };
-                RayState ray[64];
+                Rays ray;
                 // The rays' sequence before each pixel's shift: (j + 1) k_d modulo 1.
                 float kron[64][5];
                 const int rays = anyBlurred ? std::clamp(o.rays, 1, 64) : 1;
@@ -690,7 +743,7 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                         for (const Layer& l : layers) {
                             if (!l.reaches(x, y)) continue;
                             const bool fixed = l.sharp && l.timeBins == 1;
-                            active.push_back({&l, fixed, fixed ? lookup(l, {float(x) + 0.5f, float(y) + 0.5f}, 0.5f) : Lookup{}});
+                            active.push_back({&l, fixed, fixed ? lookupSharp(l, x, y, 0.5f) : Lookup{}});
                         }
                         // Where every layer a ray can reach before it ends (its transmittance
                         // below 1e-4) is sharp and still, every ray finds the same values (its
@@ -724,50 +777,43 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                                     const float v = shift[d] + kron[j][d];
                                     q[d] = v >= 1.f ? v - 1.f : v;
                                 }
-                                RayState& r = ray[j];
-                                r.u = anyBlurred ? concentricDisc(q[2], q[3]) : Vec2f{0, 0};
-                                r.u2 = r.u.x * r.u.x + r.u.y * r.u.y;
-                                r.px = float(x) + (anyBlurred ? q[0] : 0.5f);
-                                r.py = float(y) + (anyBlurred ? q[1] : 0.5f);
-                                r.dt = (anyBlurred ? q[4] : 0.5f) - 0.5f;
-                                r.c = Vec3f(0.f);
-                                r.trans = 1.f;
-                                r.hit = -1;
+                                const Vec2f u = anyBlurred ? concentricDisc(q[2], q[3]) : Vec2f{0, 0};
+                                ray.ux[j] = u.x;
+                                ray.uy[j] = u.y;
+                                ray.u2[j] = u.x * u.x + u.y * u.y;
+                                ray.px[j] = float(x) + (anyBlurred ? q[0] : 0.5f);
+                                ray.py[j] = float(y) + (anyBlurred ? q[1] : 0.5f);
+                                ray.dt[j] = (anyBlurred ? q[4] : 0.5f) - 0.5f;
+                                ray.cr[j] = ray.cg[j] = ray.cb[j] = 0.f;
+                                ray.trans[j] = 1.f;
+                                ray.hit[j] = -1;
                             }
                             for (const Active& a : active) {
                                 const Layer& l = *a.layer;
                                 const int index = int(&a - active.data());
-                                auto take = [&](RayState& r, const Lookup& v) {
-                                    r.c += v.premultiplied * r.trans;
-                                    r.trans *= 1.f - v.alpha;
+                                auto take = [&](int j, const Lookup& v) {
+                                    ray.cr[j] += v.premultiplied.x * ray.trans[j];
+                                    ray.cg[j] += v.premultiplied.y * ray.trans[j];
+                                    ray.cb[j] += v.premultiplied.z * ray.trans[j];
+                                    ray.trans[j] *= 1.f - v.alpha;
                                     if (v.alpha > 0.f) {
-                                        if (r.hit < 0) r.hit = index;
+                                        if (ray.hit[j] < 0) ray.hit[j] = index;
                                         partial |= v.alpha < 1.f - 1e-4f;
                                     }
                                 };
                                 if (a.fixed) {
                                     for (int j = j0; j < j1; ++j)
-                                        if (ray[j].trans >= 1e-4f) take(ray[j], a.value);
+                                        if (ray.trans[j] >= 1e-4f) take(j, a.value);
                                 } else if (l.sharp) {  // a sharp layer is its pixels' own samples: the ray's pixel
                                     for (int j = j0; j < j1; ++j)
-                                        if (ray[j].trans >= 1e-4f)
-                                            take(ray[j], lookup(l, {float(x) + 0.5f, float(y) + 0.5f}, ray[j].dt + 0.5f));
+                                        if (ray.trans[j] >= 1e-4f)
+                                            take(j, lookupSharp(l, x, y, ray.dt[j] + 0.5f));
                                 } else {
                                     // The layer's shear, then the slope of the surface it finds
                                     // there (one fixed-point step), shaped by the grid's blur.
-                                    const bool follow = l.followsSlope();
-                                    for (int j = j0; j < j1; ++j) {
-                                        RayState& r = ray[j];
-                                        if (r.trans < 1e-4f) continue;
-                                        const float st = r.dt * (1.f + l.rayT2 * 4.f * r.dt * r.dt);
-                                        const Vec2f mo{l.rayMx * st, l.rayMy * st};
-                                        float cRay = l.rayC + l.rayC2 * r.u2;
-                                        if (follow) {
-                                            const Shaped sh = l.shearAt(lookupSlope(l, {r.px + cRay * r.u.x - mo.x, r.py - cRay * r.u.y - mo.y}));
-                                            cRay = sh.a + sh.b * r.u2;
-                                        }
-                                        take(r, lookup(l, {r.px + cRay * r.u.x - mo.x, r.py - cRay * r.u.y - mo.y}, r.dt + 0.5f));
-                                    }
+                                    const bool follow = l.followsSlope(), moving = l.timeBins > 1;
+                                    partial |= follow ? (moving ? traceBlurred<true, true>(l, index, ray, j0, j1) : traceBlurred<true, false>(l, index, ray, j0, j1))
+                                                      : (moving ? traceBlurred<false, true>(l, index, ray, j0, j1) : traceBlurred<false, false>(l, index, ray, j0, j1));
                                 }
                             }
                         };
@@ -777,7 +823,7 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                         // remains (docs/layers.md).
                         if (pixelRays == rays && mixedRays > rays) {
                             bool straddles = partial;
-                            for (int j = 1; j < rays && !straddles; ++j) straddles = ray[j].hit != ray[0].hit;
+                            for (int j = 1; j < rays && !straddles; ++j) straddles = ray.hit[j] != ray.hit[0];
                             if (straddles) {
                                 trace(rays, mixedRays);
                                 pixelRays = mixedRays;
@@ -788,8 +834,9 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                         // the mean of what they cover.
                         Vec3f sum(0.f);
                         for (int j = 0; j < pixelRays; ++j) {
-                            const RayState& r = ray[j];
-                            sum += r.trans > 1e-4f && r.trans < 1.f ? r.c / (1.f - r.trans) : r.c;
+                            const Vec3f c(ray.cr[j], ray.cg[j], ray.cb[j]);
+                            const float t = ray.trans[j];
+                            sum += t > 1e-4f && t < 1.f ? c / (1.f - t) : c;
                         }
                         out(x, y) = sum / float(pixelRays);
                     }
