@@ -97,9 +97,10 @@ struct Layer {
     // The rays' shear, shaped by the grid's own blur (Shaped): a ray at lens point u (unit disc)
     // is sheared by (rayC + rayC2 |u|^2) u, one at time t by (1 + rayT2 (2 s)^2) s rayM, s = t -
     // 1/2. A ray that takes the slope c of the surface it finds is sheared by (A(c) + B(c)
-    // |u|^2) u, linear in a table of kShearSteps steps over the layer's slopes (traceBlurred; computing
-    // them per ray, a division and the table's lookup, measured 11-19% more time in the stage
-    // than the narrowed disc's square root before it, three rounds on conference and cornell).
+    // |u|^2) u, linear in a table of kShearSteps steps over the layer's slopes (traceBlurred;
+    // computing them per ray, a division and the table's lookup, measured 11-19% more time in
+    // the stage than the narrowed disc's square root before it, three rounds on conference and
+    // cornell).
     float rayC = 0, rayC2 = 0, rayMx = 0, rayMy = 0, rayT2 = 0;
     float gridBlur = 0;  // the grid's own blur, variance per axis (pixels^2)
     static constexpr int kShearSteps = 8;
@@ -434,8 +435,8 @@ Lookup lookupSharp(const Layer& l, int x, int y, float t) {
     return {c[0], Vec3f(r0[0], r0[1], r0[2]) * (1.f - at) + Vec3f(r1[0], r1[1], r1[2]) * at};
 }
 
-/// A pixel's reconstruction rays, a structure of arrays (a still blurred layer's step is a SIMD
-/// loop over them, traceStill): each ray's film point, lens point u (u2 = |u|^2) and shutter
+/// A pixel's reconstruction rays, a structure of arrays (a blurred layer's step is a SIMD loop
+/// over them, traceBlurred): each ray's film point, lens point u (u2 = |u|^2) and shutter
 /// offset dt = t - 1/2, and what the layers in front gave it so far (premultiplied light,
 /// transmittance, the first layer that covered it, -1 none).
 struct Rays {
@@ -449,9 +450,10 @@ struct Rays {
 /// and shutter shear, then (kFollow) the slope of the surface found there, shaped by the grid's
 /// blur, and the layer's alpha and premultiplied light there (kMoving: between its two nearest
 /// time bins) composited under what is in front, C += T alpha L, T *= 1 - alpha, for the rays
-/// not yet stopped (T >= 1e-4). Per ray the arithmetic of the scalar loop before (one ray after
-/// another, docs/layers.md), in the same order, as one SIMD loop: every lane is computed, and a stopped ray's
-/// results are not stored. Returns whether a ray took part of the layer's coverage.
+/// not yet stopped (T >= 1e-4). Per ray the arithmetic of the scalar loop it replaced, in the
+/// same order, as one SIMD loop (its images the same to float rounding, docs/layers.md): every
+/// lane is computed, and a stopped ray's results are not stored. Returns whether a ray took
+/// part of the layer's coverage.
 template <bool kFollow, bool kMoving>
 bool traceBlurred(const Layer& l, int index, Rays& ray, int j0, int j1) {
     const int cs = l.cellStride(), bins = l.timeBins;
@@ -765,8 +767,9 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                         int pixelRays = sameForEveryRay ? 1 : rays;
                         // The rays are traced a layer at a time, each layer over all the rays it
                         // has not yet stopped (transmittance below 1e-4): per ray the same
-                        // front-to-back steps, so the same image as ray after ray, with the
-                        // layer's branches and constants taken once per layer instead of per ray.
+                        // front-to-back steps as ray after ray, with the layer's branches and
+                        // constants taken once per layer and a blurred layer's step one SIMD loop
+                        // over the rays (traceBlurred).
                         // Whether the rays straddle layers: one ended on another layer than the
                         // first ray, or took part of a layer's coverage.
                         bool partial = false;
