@@ -64,16 +64,24 @@ constexpr double kKronecker[5] = {0.8812714616335696, 0.7766393890897683, 0.6844
 struct Shaped {
     float a = 0, b = 0;
 };
+/// Linear in a table of Shaped at fractional index `at` (0 <= at < its last index).
+[[gnu::always_inline]] inline Shaped lerp(const Shaped* table, float at) {
+    const int i = int(at);
+    const float f = at - float(i);
+    return {table[i].a + f * (table[i + 1].a - table[i].a), table[i].b + f * (table[i + 1].b - table[i].b)};
+}
+/// (a, b) at rho from a table at rho = 0, step, ...; none from `limit`. (Its interpolation is
+/// lerp()'s written out: through lerp() GCC contracted it differently, a few image bytes.)
 template <int N>
-Shaped shaped(float rho, const float (&table)[N][2], float step, float limit) {
+Shaped shaped(float rho, const Shaped (&table)[N], float step, float limit) {
     if (!(rho < limit)) return {};
     const float at = std::min(rho / step, float(N - 1) - 1e-3f);
     const int i = int(at);
     const float f = at - float(i);
-    return {table[i][0] + f * (table[i + 1][0] - table[i][0]), table[i][1] + f * (table[i + 1][1] - table[i][1])};
+    return {table[i].a + f * (table[i + 1].a - table[i].a), table[i].b + f * (table[i + 1].b - table[i].b)};
 }
 /// The disc's (a, b) at rho = 0, 0.025, ..., 0.475, then no shear at 1/2.
-constexpr float kDiscShape[21][2] = {
+constexpr Shaped kDiscShape[21] = {
     {1.00000f, -0.00000f}, {1.00153f, -0.00417f}, {1.00677f, -0.01492f}, {1.01555f, -0.03761f},
     {1.02771f, -0.06661f}, {1.04971f, -0.11469f}, {1.07619f, -0.17139f}, {1.12727f, -0.27347f},
     {1.17004f, -0.36329f}, {1.17198f, -0.39066f}, {1.15090f, -0.38363f}, {1.12572f, -0.37524f},
@@ -81,7 +89,7 @@ constexpr float kDiscShape[21][2] = {
     {0.91818f, -0.30606f}, {0.85231f, -0.28410f}, {0.76514f, -0.25505f}, {0.54811f, -0.18270f},
     {0.f, 0.f}};
 /// The segment's (a, b) at rho = 0, 0.02, ..., 0.28, then none at 0.3 (no shear from 1/sqrt(12)).
-constexpr float kSegmentShape[16][2] = {
+constexpr Shaped kSegmentShape[16] = {
     {1.00000f, -0.00000f}, {1.00241f, -0.00495f}, {1.00933f, -0.02554f}, {1.02231f, -0.05869f},
     {1.04543f, -0.11810f}, {1.08050f, -0.20810f}, {1.12954f, -0.32840f}, {1.13702f, -0.37901f},
     {1.10708f, -0.36903f}, {1.07402f, -0.35801f}, {1.02882f, -0.34294f}, {0.96843f, -0.32281f},
@@ -420,19 +428,25 @@ struct Bilinear {
     const int c00 = j0 * l.gw + i0;
     return {{c00, c00 + 1, c00 + l.gw, c00 + l.gw + 1}, {(1 - ax) * (1 - ay), ax * (1 - ay), (1 - ax) * ay, ax * ay}};
 }
-/// A sharp layer's cell of pixel (x, y) at shutter time t: linear in time between the time
-/// bins' centres.
+/// Shutter time t between the centres of a layer's `bins` time bins: bins b0 and b1 (the same
+/// for a still layer, one bin, or in the last bin's half) and the weight `at` of b1.
+struct TimeLerp {
+    int b0, b1;
+    float at;
+};
+[[gnu::always_inline]] inline TimeLerp timeLerp(int bins, float t) {
+    const float tb = clampValue(t * float(bins) - 0.5f, 0.f, float(bins - 1));
+    const int b0 = minValue(int(tb), bins - 1);
+    return {b0, minValue(b0 + 1, bins - 1), tb - float(b0)};
+}
+/// A sharp layer's cell of pixel (x, y) at shutter time t.
 Lookup lookupSharp(const Layer& l, int x, int y, float t) {
-    const int cs = l.cellStride();
-    const float tb = std::clamp(t * float(l.timeBins) - 0.5f, 0.f, float(l.timeBins - 1));
-    const int b0 = std::min(int(tb), l.timeBins - 1), b1 = std::min(b0 + 1, l.timeBins - 1);
-    const float at = tb - float(b0);
-    const float* c = &l.cell[(size_t(y - l.gy0) * l.gw + size_t(x - l.gx0)) * cs];
-    const float* r0 = c + 1 + 3 * b0;
-    if (b1 == b0)  // a still layer (one bin), or the last bin's half
-        return {c[0], Vec3f(r0[0], r0[1], r0[2])};
-    const float* r1 = c + 1 + 3 * b1;
-    return {c[0], Vec3f(r0[0], r0[1], r0[2]) * (1.f - at) + Vec3f(r1[0], r1[1], r1[2]) * at};
+    const TimeLerp tl = timeLerp(l.timeBins, t);
+    const float* c = &l.cell[(size_t(y - l.gy0) * l.gw + size_t(x - l.gx0)) * l.cellStride()];
+    const float* r0 = c + 1 + 3 * tl.b0;
+    if (tl.b1 == tl.b0) return {c[0], Vec3f(r0[0], r0[1], r0[2])};
+    const float* r1 = c + 1 + 3 * tl.b1;
+    return {c[0], Vec3f(r0[0], r0[1], r0[2]) * (1.f - tl.at) + Vec3f(r1[0], r1[1], r1[2]) * tl.at};
 }
 
 /// A pixel's reconstruction rays, a structure of arrays (a blurred layer's step is a SIMD loop
@@ -446,6 +460,21 @@ struct Rays {
     alignas(64) int hit[kMax];
 };
 
+/// Ray j takes alpha and premultiplied light (r, g, b) of the `index`-th layer its pixel's rays
+/// see, under what is in front, C += T alpha L, T *= 1 - alpha, unless it has stopped (T <
+/// 1e-4). Returns 1 where it took part of the layer's coverage (the rays straddle layers there).
+/// Selects, not branches, so that traceBlurred's loop vectorises.
+[[gnu::always_inline]] inline int composite(Rays& ray, int j, int index, float alpha, float r, float g, float b) {
+    const float t = ray.trans[j];
+    const bool live = t >= 1e-4f, covers = live && alpha > 0.f;
+    ray.cr[j] = live ? ray.cr[j] + r * t : ray.cr[j];
+    ray.cg[j] = live ? ray.cg[j] + g * t : ray.cg[j];
+    ray.cb[j] = live ? ray.cb[j] + b * t : ray.cb[j];
+    ray.trans[j] = live ? t * (1.f - alpha) : t;
+    ray.hit[j] = covers && ray.hit[j] < 0 ? index : ray.hit[j];
+    return covers && alpha < 1.f - 1e-4f ? 1 : 0;
+}
+
 /// Rays [j0, j1) through a blurred layer (the `index`-th a pixel's rays see): the layer's lens
 /// and shutter shear, then (kFollow) the slope of the surface found there, shaped by the grid's
 /// blur, and the layer's alpha and premultiplied light there (kMoving: between its two nearest
@@ -458,7 +487,6 @@ template <bool kFollow, bool kMoving>
 bool traceBlurred(const Layer& l, int index, Rays& ray, int j0, int j1) {
     const int cs = l.cellStride(), bins = l.timeBins;
     const float* cell = l.cell.data();
-    const Shaped* table = l.shearTable;
     int partial = 0;
 #pragma omp simd reduction(| : partial)
     for (int j = j0; j < j1; ++j) {
@@ -471,24 +499,13 @@ bool traceBlurred(const Layer& l, int index, Rays& ray, int j0, int j1) {
             float slope = 0;
 #pragma GCC unroll 4
             for (int k = 0; k < 4; ++k) slope += b.w[k] * cell[b.cell[k] * cs + cs - 1];
-            const float at = clampValue((slope - l.shearFrom) * l.shearScale, 0.f, float(Layer::kShearSteps) - 1e-3f);
-            const int i = int(at);
-            const float f = at - float(i);
-            const float sa = table[i].a + f * (table[i + 1].a - table[i].a);
-            const float sb = table[i].b + f * (table[i + 1].b - table[i].b);
-            cRay = sa + sb * ray.u2[j];
+            const Shaped sh = lerp(l.shearTable, clampValue((slope - l.shearFrom) * l.shearScale, 0.f, float(Layer::kShearSteps) - 1e-3f));
+            cRay = sh.a + sh.b * ray.u2[j];
         }
         const Bilinear b = bilinear(l, {ray.px[j] + cRay * ray.ux[j] - mox, ray.py[j] - cRay * ray.uy[j] - moy});
-        // Linear in time between the time bins' centres (one bin for a still layer, or the last
-        // bin's half).
-        int b0 = 0, b1 = 0;
-        float at = 0;
-        if constexpr (kMoving) {
-            const float tb = clampValue((dt + 0.5f) * float(bins) - 0.5f, 0.f, float(bins - 1));
-            b0 = minValue(int(tb), bins - 1);
-            b1 = minValue(b0 + 1, bins - 1);
-            at = tb - float(b0);
-        }
+        const TimeLerp tl = kMoving ? timeLerp(bins, dt + 0.5f) : TimeLerp{0, 0, 0.f};
+        const int b0 = tl.b0, b1 = tl.b1;
+        const float at = tl.at;
         float alpha = 0, r = 0, g = 0, bl = 0;
 #pragma GCC unroll 4  // (an inner loop would keep the outer one from vectorising)
         for (int k = 0; k < 4; ++k) {
@@ -508,15 +525,7 @@ bool traceBlurred(const Layer& l, int index, Rays& ray, int j0, int j1) {
                 bl += cell[c0 + 2] * w;
             }
         }
-        // Selects, not branches, so that the loop vectorises.
-        const float t = ray.trans[j];
-        const bool live = t >= 1e-4f, covers = live && alpha > 0.f;
-        ray.cr[j] = live ? ray.cr[j] + r * t : ray.cr[j];
-        ray.cg[j] = live ? ray.cg[j] + g * t : ray.cg[j];
-        ray.cb[j] = live ? ray.cb[j] + bl * t : ray.cb[j];
-        ray.trans[j] = live ? t * (1.f - alpha) : t;
-        ray.hit[j] = covers && ray.hit[j] < 0 ? index : ray.hit[j];
-        partial |= covers && alpha < 1.f - 1e-4f ? 1 : 0;
+        partial |= composite(ray, j, index, alpha, r, g, bl);
     }
     return partial != 0;
 }
@@ -713,9 +722,9 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                 std::vector<Active> active;
                 Rays ray;
                 // The rays' sequence before each pixel's shift: (j + 1) k_d modulo 1.
-                float kron[64][5];
-                const int rays = anyBlurred ? std::clamp(o.rays, 1, 64) : 1;
-                const int mixedRays = anyBlurred ? std::clamp(o.mixedRays, rays, 64) : 1;
+                float kron[Rays::kMax][5];
+                const int rays = anyBlurred ? std::clamp(o.rays, 1, Rays::kMax) : 1;
+                const int mixedRays = anyBlurred ? std::clamp(o.mixedRays, rays, Rays::kMax) : 1;
                 for (int j = 0; j < mixedRays; ++j)
                     for (int d = 0; d < 5; ++d) {
                         const double v = double(j + 1) * kKronecker[d];
@@ -795,22 +804,13 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                                 const Layer& l = *a.layer;
                                 const int index = int(&a - active.data());
                                 auto take = [&](int j, const Lookup& v) {
-                                    ray.cr[j] += v.premultiplied.x * ray.trans[j];
-                                    ray.cg[j] += v.premultiplied.y * ray.trans[j];
-                                    ray.cb[j] += v.premultiplied.z * ray.trans[j];
-                                    ray.trans[j] *= 1.f - v.alpha;
-                                    if (v.alpha > 0.f) {
-                                        if (ray.hit[j] < 0) ray.hit[j] = index;
-                                        partial |= v.alpha < 1.f - 1e-4f;
-                                    }
+                                    partial |= composite(ray, j, index, v.alpha, v.premultiplied.x, v.premultiplied.y, v.premultiplied.z) != 0;
                                 };
                                 if (a.fixed) {
-                                    for (int j = j0; j < j1; ++j)
-                                        if (ray.trans[j] >= 1e-4f) take(j, a.value);
+                                    for (int j = j0; j < j1; ++j) take(j, a.value);
                                 } else if (l.sharp) {  // a sharp layer is its pixels' own samples: the ray's pixel
                                     for (int j = j0; j < j1; ++j)
-                                        if (ray.trans[j] >= 1e-4f)
-                                            take(j, lookupSharp(l, x, y, ray.dt[j] + 0.5f));
+                                        if (ray.trans[j] >= 1e-4f) take(j, lookupSharp(l, x, y, ray.dt[j] + 0.5f));
                                 } else {
                                     // The layer's shear, then the slope of the surface it finds
                                     // there (one fixed-point step), shaped by the grid's blur.
