@@ -312,6 +312,39 @@ TEST(MaafComponents, FitKeepsTheCentralComponentsThreeSigmaInItsRadius) {
     }
 }
 
+TEST(MaafComponents, NoIndirectOuterComponentsWhereTheNearestBounceHitIsWithinTheClamp) {
+    // Issue 28: with MaafOptions::outerMinBounce, a pixel whose nearest bounce hit is closer than
+    // that share of the clamp (zMinPixels pixel sizes) has the central indirect component only;
+    // one just beyond keeps its outer components. A grazing surface (8 world units a pixel along
+    // image x, footprint 1), where the window resolves K = 5 for the clamped wedge s_min = 10.
+    const int W = 4, H = 1;
+    Plane pl(W, H);
+    WedgeField wf;
+    for (Image1f* im : {&wf.s1, &wf.s2, &wf.lightSigma, &wf.zMin, &wf.zMax, &wf.suMin, &wf.suMax, &wf.focalStraddle})
+        *im = Image1f(W, H);
+    const float zMin[W] = {2.f, 4.9f, 5.1f, 11.f};  // the clamp is 10; half of it 5
+    for (int x = 0; x < W; ++x) {
+        wf.s2[x] = wf.lightSigma[x] = kInf;  // no shadow wedge
+        wf.zMin[x] = zMin[x];
+        wf.zMax[x] = 40.f;
+    }
+    FilterFrames frames;
+    frames.direct = pl.frames;
+    frames.indirect = pl.frames;
+    for (int x = 0; x < W; ++x) frames.indirect[x].step[0] = 8.f;
+    ViewGeometry view;  // no light, no lens
+    for (float share : {0.f, 0.5f, 1.f}) {
+        MaafOptions o;
+        o.outerMinBounce = share;
+        const MaafParams params = maafParams(pl.fb, wf, frames, view, o);
+        for (int x = 0; x < W; ++x) {
+            const bool admitted = zMin[x] >= share * o.zMinPixels * pl.fb.footprint[x];
+            EXPECT_EQ(params.indirect.pairs(size_t(x), 0), admitted ? 3 : 1) << "share " << share << ", z_min " << zMin[x];
+            EXPECT_EQ(params.indirect.pairs(size_t(x), 1), 1);  // one world unit a pixel: too narrow a window
+        }
+    }
+}
+
 TEST(MaafComponents, OneComponentIsTheAxisAlignedFilterOfEq2) {
     WedgeShape w;
     w.omegaYMax = 4;

@@ -219,12 +219,22 @@ MaafParams maafParams(const FrameBuffers& fb, const WedgeField& wf, const Filter
         in.yWedge = wf.zMin[p] < kInf;
         in.omegaY = o.indirectOmega;
         in.sMin = std::max(wf.zMin[p], o.zMinPixels * d);
+        // Outer components only where the nearest bounce hit is not much closer than the clamp:
+        // a pixel that sees surfaces within a few pixel sizes (a corner, a contact) has light
+        // that varies faster than its clamped wedge says, and outer components placed by that
+        // wedge measured as bias (MaafOptions::outerMinBounce).
+        if (wf.zMin[p] < o.outerMinBounce * o.zMinPixels * d) in.fallback = true;
         in.sMax = std::max(wf.zMax[p], float(in.sMin));
         in.suMin = wf.suMin[p] * in.step;
         in.suMax = wf.suMax[p] * in.step;
         out = buildAxis(in, o);
     };
-    return MaafParams{MaafEffect(W, H, direct), MaafEffect(W, H, indirect), std::move(fallback)};
+    auto centralOnly = [](size_t, int, MaafAxis& out) {
+        out = MaafAxis{};
+        out.pairs = 1;
+    };
+    return MaafParams{o.directEffect ? MaafEffect(W, H, direct) : MaafEffect(W, H, centralOnly), MaafEffect(W, H, indirect),
+                      std::move(fallback)};
 }
 
 namespace {

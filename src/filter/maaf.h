@@ -141,6 +141,15 @@ struct MaafOptions {
     // Outer components in the direct light's (shadow x lens) filter as well as the indirect
     // light's; without them the direct filter is the central, axis-aligned one everywhere.
     bool shadowComponents = true;
+    // Whether the direct light is filtered by MAAF at all. Without (AAF's pipeline, which filters
+    // it with AAF's filter when it has no outer components) its effect is central-only everywhere
+    // and carries no widths: nothing reads them, and computing them took 1% of a render.
+    bool directEffect = true;
+    // Indirect outer components only where the nearest bounce hit is at least this share of the
+    // clamp zMinPixels (in pixel sizes) away; 0 admits every pixel (the paper's pipeline). Closer
+    // hits (a corner, a contact) vary faster than the clamped wedge says, and there the outer
+    // components measured as bias (issue 28; docs/maaf.md, "Outer components near contacts").
+    float outerMinBounce = 0.f;
     bool symmetricOuter = true;      // outer components only where a neighbour's mirror is accepted too
     bool mirrorSurfaceCuts = true;   // as AafOptions::mirrorSurfaceCuts, for every component
 };
