@@ -31,9 +31,9 @@ AxisFrame makeFrame(const Vec3f& s1, const Vec3f& s2, const Vec3f& fallback1, co
 
 }  // namespace
 
-FilterFrames computeFrames(const FrameBuffers& fb, const ViewGeometry& view) {
+FilterFrames computeFrames(const FrameBuffers& fb, const ViewGeometry& view, bool withDirect) {
     FilterFrames ff;
-    ff.direct = Image<AxisFrame>(fb.width, fb.height);
+    if (withDirect) ff.direct = Image<AxisFrame>(fb.width, fb.height);
     ff.indirect = Image<AxisFrame>(fb.width, fb.height);
     ff.light = dominantLight(view);
     const Vec3f nl = view.lights.empty() ? Vec3f(0, 1, 0) : view.lights[ff.light].normal;
@@ -46,7 +46,7 @@ FilterFrames computeFrames(const FrameBuffers& fb, const ViewGeometry& view) {
             Vec3f n = fb.normal[p];
             float depth = fb.depth[p];
             if (fb.object[p] < 0 || depth <= 0) {
-                ff.direct[p] = {{view.right, down}, {1, 1}};
+                if (withDirect) ff.direct[p] = {{view.right, down}, {1, 1}};
                 ff.indirect[p] = {{view.right, down}, {1, 1}};
                 continue;
             }
@@ -61,6 +61,7 @@ FilterFrames computeFrames(const FrameBuffers& fb, const ViewGeometry& view) {
             Vec3f s1 = (view.right - D * (dot(n, view.right) / nD)) * scale;
             Vec3f s2 = (down - D * (dot(n, down) / nD)) * scale;
             ff.indirect[p] = makeFrame(s1, s2, view.right, n);
+            if (!withDirect) continue;
             // The light's plane; a sphere light's is the one facing this receiver.
             Vec3f lp = nl, lx = la;
             if (sphere) {

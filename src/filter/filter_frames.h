@@ -24,7 +24,9 @@ struct FilterFrames {
     int light = 0;  // the light whose plane the direct frames use
 };
 
-FilterFrames computeFrames(const FrameBuffers& fb, const ViewGeometry& view);
+/// withDirect = false leaves `direct` empty (a caller that filters only the indirect light
+/// with these frames: MAAF in AAF's pipeline).
+FilterFrames computeFrames(const FrameBuffers& fb, const ViewGeometry& view, bool withDirect = true);
 
 /// The light the direct-light filters take their plane and bandwidth from: the most powerful.
 int dominantLight(const ViewGeometry& view);

@@ -229,12 +229,7 @@ MaafParams maafParams(const FrameBuffers& fb, const WedgeField& wf, const Filter
         in.suMax = wf.suMax[p] * in.step;
         out = buildAxis(in, o);
     };
-    auto centralOnly = [](size_t, int, MaafAxis& out) {
-        out = MaafAxis{};
-        out.pairs = 1;
-    };
-    return MaafParams{o.directEffect ? MaafEffect(W, H, direct) : MaafEffect(W, H, centralOnly), MaafEffect(W, H, indirect),
-                      std::move(fallback)};
+    return MaafParams{o.directEffect ? MaafEffect(W, H, direct) : MaafEffect(W, H), MaafEffect(W, H, indirect), std::move(fallback)};
 }
 
 namespace {

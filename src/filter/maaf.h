@@ -170,24 +170,28 @@ public:
     /// Writes pixel p's components along axis k.
     using Compute = std::function<void(size_t p, int k, MaafAxis& out)>;
     MaafEffect(int width, int height, Compute compute);
+    /// Central-only everywhere, with no widths: an effect MAAF does not filter (AAF's pipeline
+    /// filters it with AAF's filter). Stores nothing; pairs() is 1 and axis() the bare centre.
+    MaafEffect(int width, int height) : m_width(width), m_height(height) {}
     /// Stored parameters (tests, tiny images); `params` must outlive this.
     explicit MaafEffect(const Image<MaafPixel>& params);
 
     int width() const { return m_width; }
     int height() const { return m_height; }
     MaafAxis axis(size_t p, int k) const {
-        MaafAxis a;
-        m_compute(p, k, a);
+        MaafAxis a{};
+        if (m_compute) m_compute(p, k, a);
+        else a.pairs = 1;
         return a;
     }
     MaafPixel pixel(size_t p) const { return MaafPixel{{axis(p, 0), axis(p, 1)}}; }
     /// sx[0] of pixel p along axis k (the central component's spatial bandwidth).
-    float centralSx(size_t p, int k) const { return m_central[p].sx[k]; }
-    int pairs(size_t p, int k) const { return m_central[p].pairs[k]; }
+    float centralSx(size_t p, int k) const { return m_central.empty() ? 0.f : m_central[p].sx[k]; }
+    int pairs(size_t p, int k) const { return m_central.empty() ? 1 : m_central[p].pairs[k]; }
     /// What the image-space filter reads of pixel p's axis k: the stored central width and
     /// weight where the axis uses the central component only (most pixels), else axis(p, k).
     MaafAxis filterAxis(size_t p, int k) const {
-        if (m_central[p].pairs[k] > 1) return axis(p, k);
+        if (m_central.empty() || m_central[p].pairs[k] > 1) return axis(p, k);
         MaafAxis a{};
         a.pairs = 1;
         a.sx[0] = m_central[p].sx[k];

@@ -184,7 +184,7 @@ void renderMaaf(const MethodContext& ctx, RenderResult& result) {
     // slopes, its central filter everywhere and adaptive samples only at the focal plane (Sec. 6.2).
     const bool paper = ctx.options.maafPaperRates;
     const filter::WedgeField wedges = filter::prefilterWedges(fb, paper ? wo : filter::aafWedgeOptions());
-    filter::FilterFrames frames = filter::computeFrames(fb, view);
+    filter::FilterFrames frames = filter::computeFrames(fb, view, mo.directEffect);  // (the direct light's only if MAAF filters it)
     filter::MaafParams params = filter::maafParams(fb, wedges, frames, view, mo);
     const filter::AafOptions ao;
     const filter::AafParams rates = filter::aafParams(fb, wedges, view, ao);
@@ -309,7 +309,9 @@ void renderMaaf(const MethodContext& ctx, RenderResult& result) {
             }
             ++outerInRow;
             const filter::MaafPixel direct = params.direct.pixel(p), indirect = params.indirect.pixel(p);
-            const filter::AxisFrame &frameDirect = frames.direct[p], &frameIndirect = frames.indirect[p];
+            // (Without the direct light's frames its coordinates are not used: no accDirect.)
+            const filter::AxisFrame &frameIndirect = frames.indirect[p],
+                                    &frameDirect = frames.direct.size() > 0 ? frames.direct[p] : frameIndirect;
             uint32_t counted = 0;
             auto accumulate = [&](const filter::MaafSample& m) {
                 if (m.slot != primary) return;
