@@ -23,7 +23,6 @@ struct Gathered {
     uint32_t pixel;             // where it was taken (row-major)
     int8_t surface;
     bool moving;
-    int layer;
 };
 
 /// A layer whose slopes spread less than this (pixels per unit lens coordinate) is sheared with
@@ -198,36 +197,64 @@ struct SlopeRange {
     }
 };
 
-/// Splits the tile's samples into layers, front to back (see layers.h, step 1); sets
-/// Gathered::layer. `range[moving]`: the slopes of the still and the moving samples. Two passes
-/// over the samples, both classes at once (the tile's samples are megabytes: each pass is a
-/// trip through memory).
-std::vector<Layer> splitLayers(std::vector<Gathered>& g, const SlopeRange (&range)[2], const LayerOptions& o) {
-    // Per class, a histogram of slopes, nearest (largest c) first.
+/// A tile's layers, front to back, and which layer a sample is in (splitLayers).
+struct Split {
+    /// Per class (still, moving), a histogram of slopes, nearest (largest c) first, with each
+    /// bin's sums: a layer is a run of bins, so its statistics are its bins'.
     struct Histogram {
         float cHi = 0, binW = 1;
         int bins = 0, base = 0;
         std::vector<int> count, binLayer;
+        std::vector<double> sumC, sumMx, sumMy, sumInvDepth;
+        std::vector<float> cMin, cMax;
         int bin(float c) const { return std::clamp(int((cHi - c) / binW), 0, bins - 1); }
     };
     Histogram hist[2];
+    std::vector<int> rank;  // front-to-back rank of the layer of a histogram's run
+    std::vector<Layer> layers;
+    /// The layer (index into `layers`) of sample s.
+    int layerOf(const Gathered& s) const {
+        const Histogram& h = hist[s.moving];
+        return rank[h.base + h.binLayer[h.bin(s.c)]];
+    }
+};
+
+/// Splits the tile's samples into layers, front to back (see layers.h, step 1).
+/// `range[moving]`: the slopes of the still and the moving samples. One pass over the samples,
+/// both classes at once, into the histograms and their bins' sums (the tile's samples are
+/// megabytes: each pass is a trip through memory; three passes, with one to set each sample's
+/// layer and one to renumber it front to back, were a tenth of an MC render of
+/// docs/motion.json); the splat takes each sample's layer from its bin (Split::layerOf).
+void splitLayers(const std::vector<Gathered>& g, const SlopeRange (&range)[2], const LayerOptions& o, Split& split) {
+    auto& hist = split.hist;
     for (int moving = 0; moving < 2; ++moving) {
         const SlopeRange& r = range[moving];
+        Split::Histogram& h = hist[moving];
+        h.bins = 0;
         if (r.n == 0) continue;
-        Histogram& h = hist[moving];
         h.cHi = r.hi;
         h.binW = std::max(0.25f, (r.hi - r.lo) / 2048.f);
         h.bins = int((r.hi - r.lo) / h.binW) + 1;
         h.count.assign(h.bins, 0);
         h.binLayer.assign(h.bins, -1);
+        for (auto* v : {&h.sumC, &h.sumMx, &h.sumMy, &h.sumInvDepth}) v->assign(h.bins, 0.0);
+        h.cMin.assign(h.bins, kInf);
+        h.cMax.assign(h.bins, -kInf);
     }
     for (const Gathered& s : g) {
-        Histogram& h = hist[s.moving];
-        ++h.count[h.bin(s.c)];
+        Split::Histogram& h = hist[s.moving];
+        const int b = h.bin(s.c);
+        ++h.count[b];
+        h.sumC[b] += s.c;
+        h.sumMx[b] += s.mx;
+        h.sumMy[b] += s.my;
+        h.sumInvDepth[b] += s.invDepth;
+        h.cMin[b] = std::min(h.cMin[b], s.c);
+        h.cMax[b] = std::max(h.cMax[b], s.c);
     }
     std::vector<Layer> layers;
     for (int moving = 0; moving < 2; ++moving) {
-        Histogram& h = hist[moving];
+        Split::Histogram& h = hist[moving];
         if (h.bins == 0) continue;  // no samples of this class
         int nLayers = 0;
         for (float scale = 1.f;; scale *= 1.5f) {
@@ -251,18 +278,19 @@ std::vector<Layer> splitLayers(std::vector<Gathered>& g, const SlopeRange (&rang
         h.base = int(layers.size());
         layers.resize(h.base + nLayers);
         for (int k = h.base; k < h.base + nLayers; ++k) layers[k].moving = bool(moving);
-    }
-    for (Gathered& s : g) {
-        const Histogram& h = hist[s.moving];
-        s.layer = h.base + h.binLayer[h.bin(s.c)];
-        Layer& l = layers[s.layer];
-        ++l.count;
-        l.sumC += s.c;
-        l.sumMx += s.mx;
-        l.sumMy += s.my;
-        l.sumInvDepth += s.invDepth;
-        l.cMin = std::min(l.cMin, s.c);
-        l.cMax = std::max(l.cMax, s.c);
+        // A layer's statistics are those of its bins (summed bin by bin: the means can differ
+        // from a sample-by-sample sum in the last bits of the double sums).
+        for (int b = 0; b < h.bins; ++b) {
+            if (h.count[b] == 0) continue;
+            Layer& l = layers[h.base + h.binLayer[b]];
+            l.count += h.count[b];
+            l.sumC += h.sumC[b];
+            l.sumMx += h.sumMx[b];
+            l.sumMy += h.sumMy[b];
+            l.sumInvDepth += h.sumInvDepth[b];
+            l.cMin = std::min(l.cMin, h.cMin[b]);
+            l.cMax = std::max(l.cMax, h.cMax[b]);
+        }
     }
     for (Layer& l : layers) {
         const double inv = 1.0 / std::max(1, l.count);
@@ -275,15 +303,13 @@ std::vector<Layer> splitLayers(std::vector<Gathered>& g, const SlopeRange (&rang
     std::vector<int> order(layers.size());
     for (size_t i = 0; i < order.size(); ++i) order[i] = int(i);
     std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return layers[a].invDepth > layers[b].invDepth; });
-    std::vector<int> rank(layers.size());
-    std::vector<Layer> sorted;
-    sorted.reserve(layers.size());
+    split.rank.assign(layers.size(), 0);
+    split.layers.clear();
+    split.layers.reserve(layers.size());
     for (size_t i = 0; i < order.size(); ++i) {
-        rank[order[i]] = int(i);
-        sorted.push_back(std::move(layers[order[i]]));
+        split.rank[order[i]] = int(i);
+        split.layers.push_back(std::move(layers[order[i]]));
     }
-    for (Gathered& s : g) s.layer = rank[s.layer];
-    return sorted;
 }
 
 /// Separable Gaussian of `sigma` cells over the `stride` interleaved channels of `acc` (gw x gh).
@@ -565,6 +591,7 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
     const float pad = std::ceil(3.f * o.sigmaMax) + 2.f;
     parallelTiles(tilesX, tilesY, 1, [&](int tx0, int tx1, int ty0, int ty1) {
         std::vector<Gathered> g;
+        Split split;
         for (int ty = ty0; ty < ty1; ++ty)
             for (int tx = tx0; tx < tx1; ++tx) {
                 const int X0 = tx * T, Y0 = ty * T, X1 = std::min(W, X0 + T), Y1 = std::min(H, Y0 + T);
@@ -606,7 +633,6 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                             a.radiance = s.radiance;
                             a.pixel = uint32_t(q);
                             a.surface = int8_t(s.surface());
-                            a.layer = 0;
                             range[a.moving].add(a.c);
                             g.push_back(a);
                         });
@@ -626,7 +652,8 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                     const Image3f* light = s.surface >= 0 ? in.surfaceLight[s.surface] : nullptr;
                     return light ? unpackRgb9e5(s.albedo) * (*light)[s.pixel] : unpackRgb9e5(s.radiance);
                 };
-                std::vector<Layer> layers = splitLayers(g, range, o);
+                splitLayers(g, range, o, split);
+                std::vector<Layer>& layers = split.layers;
                 layerTotal += layers.size();
                 bool anyBlurred = false;
                 for (Layer& l : layers) {
@@ -674,15 +701,16 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                 blurredTotal += anyBlurred ? 1 : 0;
                 // Splat: N and D at the layer's shear, W and the radiance at the sample's own.
                 for (const Gathered& s : g) {
+                    const int sl = split.layerOf(s);
                     // D of the layers in front, at their shear: where this sample shows that
                     // they do not cover.
-                    for (int k = 0; k < s.layer; ++k) {
+                    for (int k = 0; k < sl; ++k) {
                         Layer& l = layers[k];
                         const int ci = l.cellIndex(l.sharpPosition(s));
                         if (ci >= 0) l.accD[ci] += 1.f;
                     }
                     // Its own layer's N, D, W and radiance at its own trajectory's point.
-                    Layer& l = layers[s.layer];
+                    Layer& l = layers[sl];
                     Vec2f own{s.x, s.y};
                     if (!l.sharp) {
                         const float dt = s.t - 0.5f;
