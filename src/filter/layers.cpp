@@ -186,15 +186,10 @@ struct Layer {
     }
 };
 
-/// The slopes of one class of a tile's samples (still or moving), gathered as they are read.
+/// The slopes of one class of a tile's samples (still or moving); lo > hi where it has none.
 struct SlopeRange {
     float lo = kInf, hi = -kInf;
-    size_t n = 0;
-    void add(float c) {
-        lo = std::min(lo, c);
-        hi = std::max(hi, c);
-        ++n;
-    }
+    bool empty() const { return lo > hi; }
 };
 
 /// A tile's layers, front to back, and which layer a sample is in (splitLayers).
@@ -231,7 +226,7 @@ void splitLayers(const std::vector<Gathered>& g, const SlopeRange (&range)[2], c
         const SlopeRange& r = range[moving];
         Split::Histogram& h = hist[moving];
         h.bins = 0;
-        if (r.n == 0) continue;
+        if (r.empty()) continue;
         h.cHi = r.hi;
         h.binW = std::max(0.25f, (r.hi - r.lo) / 2048.f);
         h.bins = int((r.hi - r.lo) / h.binW) + 1;
@@ -612,7 +607,10 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                 for (int y = ry0; y < ry1; ++y)
                     for (int x = rx0; x < rx1; ++x) expected += lf.count(size_t(y) * W + x);
                 g.reserve(expected);
-                SlopeRange range[2];  // of the still and the moving samples
+                // The slopes of the still and the moving samples, kept in registers while the
+                // samples are read (as range[moving].add(c) they went through memory, a store
+                // and a load per sample on the gather's critical path).
+                float lo[2] = {kInf, kInf}, hi[2] = {-kInf, -kInf};
                 for (int y = ry0; y < ry1; ++y)
                     for (int x = rx0; x < rx1; ++x) {
                         const size_t q = size_t(y) * W + x;
@@ -633,11 +631,17 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                             a.radiance = s.radiance;
                             a.pixel = uint32_t(q);
                             a.surface = int8_t(s.surface());
-                            range[a.moving].add(a.c);
+                            const bool mv = a.moving;
+                            const float c = a.c;
+                            lo[0] = !mv && c < lo[0] ? c : lo[0];
+                            hi[0] = !mv && c > hi[0] ? c : hi[0];
+                            lo[1] = mv && c < lo[1] ? c : lo[1];
+                            hi[1] = mv && c > hi[1] ? c : hi[1];
                             g.push_back(a);
                         });
                     }
                 gatheredTotal += g.size();
+                const SlopeRange range[2] = {{lo[0], hi[0]}, {lo[1], hi[1]}};
                 if (g.empty()) {
                     for (int y = Y0; y < Y1; ++y)
                         for (int x = X0; x < X1; ++x) out(x, y) = Vec3f(0.f);
