@@ -236,17 +236,45 @@ void splitLayers(const std::vector<Gathered>& g, const SlopeRange (&range)[2], c
         h.cMin.assign(h.bins, kInf);
         h.cMax.assign(h.bins, -kInf);
     }
+    // Consecutive samples mostly fall in one bin (a pixel's, its neighbour's: one surface), so
+    // each class sums its current run of one bin in registers and adds the run to the bin when
+    // the bin changes (summing into the bin sample by sample chained every add through memory).
+    struct Run {
+        int bin = -1, count = 0;
+        double c = 0, mx = 0, my = 0, invDepth = 0;
+        float cMin = kInf, cMax = -kInf;
+    };
+    Run run[2];
+    auto flush = [&](int moving) {
+        Run& r = run[moving];
+        if (r.bin < 0) return;
+        Split::Histogram& h = hist[moving];
+        h.count[r.bin] += r.count;
+        h.sumC[r.bin] += r.c;
+        h.sumMx[r.bin] += r.mx;
+        h.sumMy[r.bin] += r.my;
+        h.sumInvDepth[r.bin] += r.invDepth;
+        h.cMin[r.bin] = std::min(h.cMin[r.bin], r.cMin);
+        h.cMax[r.bin] = std::max(h.cMax[r.bin], r.cMax);
+        r = Run{};
+    };
     for (const Gathered& s : g) {
-        Split::Histogram& h = hist[s.moving];
-        const int b = h.bin(s.c);
-        ++h.count[b];
-        h.sumC[b] += s.c;
-        h.sumMx[b] += s.mx;
-        h.sumMy[b] += s.my;
-        h.sumInvDepth[b] += s.invDepth;
-        h.cMin[b] = std::min(h.cMin[b], s.c);
-        h.cMax[b] = std::max(h.cMax[b], s.c);
+        const int b = hist[s.moving].bin(s.c);
+        Run& r = run[s.moving];
+        if (b != r.bin) {
+            flush(s.moving);
+            r.bin = b;
+        }
+        ++r.count;
+        r.c += s.c;
+        r.mx += s.mx;
+        r.my += s.my;
+        r.invDepth += s.invDepth;
+        r.cMin = std::min(r.cMin, s.c);
+        r.cMax = std::max(r.cMax, s.c);
     }
+    flush(0);
+    flush(1);
     std::vector<Layer> layers;
     for (int moving = 0; moving < 2; ++moving) {
         Split::Histogram& h = hist[moving];
