@@ -653,7 +653,10 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                             a.mx = m.x;
                             a.my = m.y;
                             a.moving = m.x * m.x + m.y * m.y > kMoving * kMoving;
-                            a.c = view.defocusSlope(s.hit() ? s.depth : kInf);
+                            // (A non-finite slope, which no valid scene gives, counts as in
+                            // focus: every sample must fall in a slope bin of its class.)
+                            const float slope = view.defocusSlope(s.hit() ? s.depth : kInf);
+                            a.c = std::isfinite(slope) ? slope : 0.f;
                             a.invDepth = s.hit() ? 1.f / std::max(s.depth, 1e-6f) : 0.f;
                             a.albedo = s.albedo;
                             a.radiance = s.radiance;
