@@ -143,7 +143,8 @@ struct MaafOptions {
     bool shadowComponents = true;
     // Whether the direct light is filtered by MAAF at all. Without (AAF's pipeline, which filters
     // it with AAF's filter when it has no outer components) its effect is central-only everywhere
-    // and carries no widths: nothing reads them, and computing them took 1% of a render.
+    // and carries no widths: nothing reads them (computing them took 0.005-0.011 s of a
+    // 512x512 cornell render on two threads, and 5 MB of fresh memory).
     bool directEffect = true;
     // Indirect outer components only where the nearest bounce hit is at least this share of the
     // clamp zMinPixels (in pixel sizes) away; 0 admits every pixel (the paper's pipeline). Closer

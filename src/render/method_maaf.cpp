@@ -69,8 +69,8 @@ void renderMaaf(const MethodContext& ctx, RenderResult& result) {
     // (half the clamp). Measured against 1024-spp references (relMSE against AAF's, seeds 1 and 2
     // at 256x256; docs/maaf.md, "Outer components near contacts"), every pixel / half the clamp /
     // the whole clamp: cornell at 512x512 +3.5% / -0.3% / -0.7%, at 256x256 -2.5% / -1.4% /
-    // -0.3%; cornell-sphere -2.6% / -1.9% / -0.9% and -4.0% / -0.6% / +0.1%; conference -0.9% /
-    // -0.8% / -0.3% and -2.7% / -1.8% / -0.9%. The paper's pipeline keeps every pixel's.
+    // -0.3%; cornell-sphere -2.6% / -1.9% / -0.9% and -4.0% / -0.6% / +0.1%; conference -0.8% /
+    // -0.8% / -0.3% and -2.8% / -1.8% / -0.9%. The paper's pipeline keeps every pixel's.
     mo.outerMinBounce = ctx.options.maafPaperRates ? 0.f : 0.5f;
     // Without outer components the direct light's filter is AAF's (below): no MAAF widths for it.
     mo.directEffect = mo.shadowComponents;
