@@ -185,6 +185,52 @@ TEST(Layers, AConstantLightFieldStaysConstantAndEmptyTilesGiveNoNaN) {
         }
 }
 
+TEST(Layers, WhereAFilteredLightIsAnotherPointsASampleCarriesItsOwn) {
+    // One plane filling the view, every sample of own radiance 0.5; the filtered light of the
+    // primary surface is 0.2, of the others 0.9 (albedo 1). In a blurred still layer a sample on
+    // another surface than its pixel's primary one carries its own light (its filtered light is
+    // a neighbour's), and so do the primary surface's samples of a pixel that saw several
+    // surfaces where the layer's slope is at least 2 px; everywhere else, the filtered light:
+    // in a sharp (in focus) layer, in a moving one (its light split over the shutter's bins).
+    const int W = 64, H = 64;
+    const ViewGeometry view = wideLensView(W, H);
+    Image3f primaryLight(W, H), otherLight(W, H);
+    for (size_t i = 0; i < primaryLight.size(); ++i) primaryLight[i] = Vec3f(0.2f), otherLight[i] = Vec3f(0.9f);
+    // A pixel's first sample on surface `first`, the other 15 on `rest`.
+    auto reconstruct = [&](float depth, Vec2f motion, int first, int rest) {
+        LightFieldSamples lf(W, H);
+        const int stage = lf.addStage([](size_t) { return 16u; });
+        std::mt19937 rng(3);
+        std::uniform_real_distribution<float> uni(0.f, 1.f);
+        for (size_t p = 0; p < size_t(W) * H; ++p) {
+            LightFieldSample* run = lf.run(stage, p);
+            for (int k = 0; k < 16; ++k)
+                run[k] = LightFieldSample::pack({uni(rng), uni(rng)}, concentricDisc(uni(rng), uni(rng)), uni(rng), depth,
+                                                motion, Vec3f(1.f), Vec3f(0.5f), k == 0 ? first : rest);
+        }
+        const Image3f out = filter::reconstructLayers(filter::LayerInput{lf, view, {&primaryLight, &otherLight, &otherLight}});
+        double mean = 0;  // over the pixels away from the borders, where every ray finds samples
+        for (int y = 16; y < 48; ++y)
+            for (int x = 16; x < 48; ++x) mean += out(x, y).x / (32.0 * 32.0);
+        return mean;
+    };
+    const float defocused = 1.f, inFocus = 2.f, slightly = 1.f / (0.5f + 0.16f);  // slopes +5, 0, +1.6 px
+    ASSERT_GT(view.defocusSlope(defocused), 4.f);
+    ASSERT_EQ(view.defocusSlope(inFocus), 0.f);
+    ASSERT_GT(view.defocusSlope(slightly), 1.5f);  // blurred (a disc's variance above the grid's own)
+    ASSERT_LT(view.defocusSlope(slightly), 2.f);
+    EXPECT_NEAR(reconstruct(defocused, {0, 0}, 0, 0), 0.2, 1e-4);
+    EXPECT_NEAR(reconstruct(defocused, {0, 0}, 1, 1), 0.5, 1e-4);
+    EXPECT_NEAR(reconstruct(defocused, {0, 0}, 1, 0), 0.5, 1e-4);  // every pixel saw two surfaces
+    EXPECT_NEAR(reconstruct(defocused, {0, 0}, -1, 0), 0.5, 1e-4);  // ... one of them untracked
+    EXPECT_NEAR(reconstruct(slightly, {0, 0}, 1, 0), (15 * 0.2 + 0.5) / 16, 2e-3);
+    EXPECT_NEAR(reconstruct(inFocus, {0, 0}, 1, 1), 0.9, 1e-4);
+    EXPECT_NEAR(reconstruct(inFocus, {0, 0}, 1, 0), (15 * 0.2 + 0.9) / 16, 2e-3);
+    EXPECT_NEAR(reconstruct(inFocus, {12, 0}, 1, 1), 0.9, 1e-4);
+    EXPECT_NEAR(reconstruct(defocused, {12, 0}, 1, 1), 0.9, 1e-4);
+    EXPECT_NEAR(reconstruct(defocused, {12, 0}, 1, 0), (15 * 0.2 + 0.9) / 16, 2e-3);
+}
+
 TEST(Layers, OnlyPixelsWhoseRaysStraddleLayersTakeTheExtraRays) {
     // A defocused disc (depth 1, slope +5 px) over a far wall (depth 10, slope -4 px), 16 samples
     // a pixel, radiance varying so that more rays change a pixel's value. The extra rays

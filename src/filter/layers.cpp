@@ -34,6 +34,9 @@ constexpr float kMoving = 0.5f;
 /// shading changes as it moves (towards or away from a light), and the reconstruction rays take
 /// the radiance of their own time (linear between the bins' centres).
 constexpr int kTimeBins = 8;
+/// In a blurred still layer of at least this slope (pixels), the samples of a pixel that saw
+/// several surfaces carry their own light, not their pixel's filtered light (radianceOf).
+constexpr float kOwnLightSlope = 2.f;
 /// The reconstruction rays' sequence: the powers 1 / phi^k, k = 1..5, of the root of
 /// x^6 = x + 1 (phi = 1.13472413840152), modulo 1.
 constexpr double kKronecker[5] = {0.8812714616335696, 0.7766393890897683, 0.6844301295853427, 0.6031687406857283,
@@ -589,11 +592,14 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
 
     // How far each pixel's samples' trajectories reach (2 |c| + |m| from where they were taken).
     std::vector<float> reach(size_t(W) * H, 0.f);
+    // Whether a pixel's samples saw several surfaces (what the sample carries: radianceOf below).
+    std::vector<uint8_t> mixed(size_t(W) * H, 0);
     parallelRows(H, [&](int y) {
         for (int x = 0; x < W; ++x) {
             const size_t p = size_t(y) * W + x;
             float r = 0;
             lf.forEach(p, [&](const LightFieldSample& s) {
+                if (s.surface() != 0) mixed[p] = 1;
                 const Vec2f m = s.motion();
                 const float c = view.defocusSlope(s.hit() ? s.depth : kInf);
                 r = std::max(r, 2.f * std::abs(c) + std::sqrt(m.x * m.x + m.y * m.y));
@@ -683,8 +689,31 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                 // it has any, and only the coverage from the layers, measured worse: AAF relMSE
                 // at 512x512 cornell 0.0000699 -> 0.0000882, sponza 0.000668 -> 0.000889,
                 // docs/motion.json 0.0000931 -> 0.000142, conference 0.000625 -> 0.000719.)
-                auto radianceOf = [&](const Gathered& s) {
-                    const Image3f* light = s.surface >= 0 ? in.surfaceLight[s.surface] : nullptr;
+                // In a blurred still layer a sample carries its own light where its surface's
+                // filtered light is another point's: on another surface than its pixel's primary
+                // one (that surface's filtered light is a film-space neighbour's,
+                // FrameBuffers::surfaceLight), and on the primary surface of a pixel that saw
+                // several where the layer's circle of confusion is at least kOwnLightSlope
+                // pixels (the pixel's filtered light is a mean over its circle of confusion and
+                // the filter's neighbours, which at a silhouette lie on either side of it). The
+                // layer's grid and the rays' disc average the samples' own light over many
+                // samples anyway. Measured, AAF at 512x512, 16 spp, relMSE against the 1024-spp
+                // references (docs/layers.md), the filtered light -> other surfaces' own -> also
+                // the mixed pixels' primary surface's own at |c| >= 2 px: conference 0.000588 ->
+                // 0.000536 -> 0.000485, sponza 0.000656 -> 0.000609 -> 0.000586, bunny 0.000112
+                // -> 0.000110 -> 0.000109, cornell-sphere 0.000129 -> 0.000128 -> 0.000124,
+                // cornell 0.0000709 -> 0.0000712 -> 0.0000712. The mixed pixels' primary
+                // surface at any slope (|c| >= 1 px): cornell 0.0000748, conference 0.000486;
+                // the other surfaces only at |c| >= 1 / 2 / 4 px: conference 0.000536 / 0.000544
+                // / 0.000582, sponza 0.000627 / 0.000641 / 0.000650; every primary surface's
+                // sample of a blurred layer: conference at 256x256 1.6x worse (the defocused
+                // interiors' variance). A moving layer keeps the filtered light: its radiance is
+                // split over 8 time bins, a bin averages an eighth of the samples
+                // (docs/motion.json 0.0000891 -> 0.0000898 with the other surfaces' own).
+                auto radianceOf = [&](const Gathered& s, const Layer& l) {
+                    const bool own = !l.sharp && !l.moving &&
+                                     (s.surface > 0 || (s.surface == 0 && mixed[s.pixel] && std::abs(l.c) >= kOwnLightSlope));
+                    const Image3f* light = s.surface >= 0 && !own ? in.surfaceLight[s.surface] : nullptr;
                     return light ? unpackRgb9e5(s.albedo) * (*light)[s.pixel] : unpackRgb9e5(s.radiance);
                 };
                 splitLayers(g, range, o, split);
@@ -756,7 +785,7 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                     l.acc[size_t(ci) * l.accStride()] += 1.f;
                     l.accD[ci] += 1.f;
                     l.acc[size_t(ci + 1) * l.accStride() - 1] += s.c;
-                    const Vec3f radiance = radianceOf(s);
+                    const Vec3f radiance = radianceOf(s, l);
                     float* a = &l.acc[size_t(ci) * l.accStride() + 1 + 4 * l.timeBin(s.t)];
                     a[0] += 1.f;
                     a[1] += radiance.x;
