@@ -703,7 +703,9 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                 // 0.000536 -> 0.000485, sponza 0.000656 -> 0.000609 -> 0.000586, bunny 0.000112
                 // -> 0.000110 -> 0.000109, cornell-sphere 0.000129 -> 0.000128 -> 0.000124,
                 // cornell 0.0000709 -> 0.0000712 -> 0.0000712. The mixed pixels' primary
-                // surface at any slope (|c| >= 1 px): cornell 0.0000748, conference 0.000486;
+                // surface at any slope (|c| >= 1 px): cornell 0.0000748, conference 0.000486; at
+                // |c| >= 3 px: conference 0.000528, cornell 0.0000709; in the pixels next to
+                // the mixed ones as well: within 1% (cornell +1%, conference -0.4%);
                 // the other surfaces only at |c| >= 1 / 2 / 4 px: conference 0.000536 / 0.000544
                 // / 0.000582, sponza 0.000627 / 0.000641 / 0.000650; every primary surface's
                 // sample of a blurred layer: conference at 256x256 1.6x worse (the defocused

@@ -45,8 +45,12 @@
 //
 // The radiance a sample carries is its surface's light as the method filtered it (AAF's or
 // MAAF's filtered direct and indirect light of the sample's surface in its pixel, times the
-// sample's own albedo) or, without filtered light, its own. Emitted light is not reconstructed
-// here: the caller adds each pixel's own (densely sampled at emitter edges).
+// sample's own albedo) or, without filtered light, its own. In a blurred still layer it carries
+// its own light also where the filtered light is another point's: a surface other than its
+// pixel's primary one (whose filtered light is a neighbour pixel's), and the primary surface of a
+// pixel that saw several, where the layer's slope is at least 2 px (layers.cpp, radianceOf).
+// Emitted light is not reconstructed here: the caller adds each pixel's own (densely sampled at
+// emitter edges).
 #pragma once
 
 #include <array>
@@ -73,8 +77,9 @@ struct LayerInput {
     const LightFieldSamples& samples;
     ViewGeometry view;
     /// The filtered demodulated light of each FrameBuffers surface (0: the primary, 1 + k:
-    /// other[k]); a sample on surface k of pixel p carries albedo x (*surfaceLight[k])[p]. Null:
-    /// the samples on that surface carry their own radiance.
+    /// other[k]); a sample on surface k of pixel p carries albedo x (*surfaceLight[k])[p] (but
+    /// where that is another point's light, above). Null: the samples on that surface carry
+    /// their own radiance.
     std::array<const Image3f*, 1 + FrameBuffers::kOtherSurfaces> surfaceLight{};
 };
 
