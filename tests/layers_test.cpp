@@ -190,7 +190,8 @@ TEST(Layers, WhereAFilteredLightIsAnotherPointsASampleCarriesItsOwn) {
     // primary surface is 0.2, of the others 0.9 (albedo 1). In a blurred still layer a sample on
     // another surface than its pixel's primary one carries its own light (its filtered light is
     // a neighbour's), and so do the primary surface's samples of a pixel that saw several
-    // surfaces where the layer's slope is at least 2 px; everywhere else, the filtered light:
+    // surfaces where the layer's slope is at least 2 px, and every sample where it is at least
+    // 8 px (the filtered light would blur twice); everywhere else, the filtered light:
     // in a sharp (in focus) layer, in a moving one (its light split over the shutter's bins).
     const int W = 64, H = 64;
     const ViewGeometry view = wideLensView(W, H);
@@ -220,6 +221,9 @@ TEST(Layers, WhereAFilteredLightIsAnotherPointsASampleCarriesItsOwn) {
     ASSERT_GT(view.defocusSlope(slightly), 1.5f);  // blurred (a disc's variance above the grid's own)
     ASSERT_LT(view.defocusSlope(slightly), 2.f);
     EXPECT_NEAR(reconstruct(defocused, {0, 0}, 0, 0), 0.2, 1e-4);
+    const float farOff = 0.5f;  // slope +10 px: every sample its own light
+    ASSERT_GT(view.defocusSlope(farOff), 8.f);
+    EXPECT_NEAR(reconstruct(farOff, {0, 0}, 0, 0), 0.5, 1e-4);
     EXPECT_NEAR(reconstruct(defocused, {0, 0}, 1, 1), 0.5, 1e-4);
     EXPECT_NEAR(reconstruct(defocused, {0, 0}, 1, 0), 0.5, 1e-4);  // every pixel saw two surfaces
     EXPECT_NEAR(reconstruct(defocused, {0, 0}, -1, 0), 0.5, 1e-4);  // ... one of them untracked

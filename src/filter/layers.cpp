@@ -37,6 +37,10 @@ constexpr int kTimeBins = 8;
 /// In a blurred still layer of at least this slope (pixels), the samples of a pixel that saw
 /// several surfaces carry their own light, not their pixel's filtered light (radianceOf).
 constexpr float kOwnLightSlope = 2.f;
+/// ... and every sample of a blurred still layer of at least this slope: its rays' disc averages
+/// pi c^2 pixels' samples (3200 at 8 px and 16 spp), more than the filter did, and the pixel's
+/// filtered light, already a mean over its own circle of confusion, would blur twice.
+constexpr float kOwnLightAll = 8.f;
 /// The reconstruction rays' sequence: the powers 1 / phi^k, k = 1..5, of the root of
 /// x^6 = x + 1 (phi = 1.13472413840152), modulo 1.
 constexpr double kKronecker[5] = {0.8812714616335696, 0.7766393890897683, 0.6844301295853427, 0.6031687406857283,
@@ -712,9 +716,22 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                 // interiors' variance). A moving layer keeps the filtered light: its radiance is
                 // split over 8 time bins, a bin averages an eighth of the samples
                 // (docs/motion.json 0.0000891 -> 0.0000898 with the other surfaces' own).
+                // Where a layer's slope is kOwnLightAll or more, every sample carries its own
+                // light: the filtered light's second blur is then the larger error. Measured,
+                // AAF relMSE at 384x384 (held out: bunny under twice its aperture focused at
+                // 3, conference under twice its aperture) and 512x512, every pixel at 3 / 4 /
+                // 6 / 8 / 12 px / never: bunny-near 0.0000977 / 0.0000969 / 0.0000962 /
+                // 0.0000961 / 0.000246 / 0.000289 (AAF without layers 0.000140, MC with layers
+                // 0.000105), conference-wide 0.00122 / 0.00120 / 0.00119 / 0.00120 / 0.00121 /
+                // 0.00121, bunny 0.000105 / 0.000104 / 0.000103 / 0.000103 / 0.000109 /
+                // 0.000109, sponza 0.000606 / 0.000596 / 0.000588 / 0.000586 / 0.000586 /
+                // 0.000586, cornell 0.0000923 / 0.0000712 / ... (the same from 4 px on),
+                // cornell-sphere 0.000168 / 0.000124 / ..., conference 0.000534 / 0.000486 /
+                // 0.000485 / ...
                 auto radianceOf = [&](const Gathered& s, const Layer& l) {
+                    const float c = std::abs(l.c);
                     const bool own = !l.sharp && !l.moving &&
-                                     (s.surface > 0 || (s.surface == 0 && mixed[s.pixel] && std::abs(l.c) >= kOwnLightSlope));
+                                     (s.surface > 0 || (s.surface == 0 && (c >= kOwnLightAll || (mixed[s.pixel] && c >= kOwnLightSlope))));
                     const Image3f* light = s.surface >= 0 && !own ? in.surfaceLight[s.surface] : nullptr;
                     return light ? unpackRgb9e5(s.albedo) * (*light)[s.pixel] : unpackRgb9e5(s.radiance);
                 };
