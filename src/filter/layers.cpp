@@ -694,7 +694,8 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                 // at 512x512 cornell 0.0000699 -> 0.0000882, sponza 0.000668 -> 0.000889,
                 // docs/motion.json 0.0000931 -> 0.000142, conference 0.000625 -> 0.000719.)
                 // In a blurred still layer a sample carries its own light where its surface's
-                // filtered light is another point's: on another surface than its pixel's primary
+                // filtered light is another point's (and, below, wherever the layer's blur is
+                // large): on another surface than its pixel's primary
                 // one (that surface's filtered light is a film-space neighbour's,
                 // FrameBuffers::surfaceLight), and on the primary surface of a pixel that saw
                 // several where the layer's circle of confusion is at least kOwnLightSlope

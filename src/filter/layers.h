@@ -48,7 +48,8 @@
 // sample's own albedo) or, without filtered light, its own. In a blurred still layer it carries
 // its own light also where the filtered light is another point's: a surface other than its
 // pixel's primary one (whose filtered light is a neighbour pixel's), and the primary surface of a
-// pixel that saw several, where the layer's slope is at least 2 px (layers.cpp, radianceOf).
+// pixel that saw several, where the layer's slope is at least 2 px; and every sample where the
+// slope is at least 8 px, where the filtered light would blur twice (layers.cpp, radianceOf).
 // Emitted light is not reconstructed here: the caller adds each pixel's own (densely sampled at
 // emitter edges).
 #pragma once
