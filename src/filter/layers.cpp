@@ -693,42 +693,24 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                 // it has any, and only the coverage from the layers, measured worse: AAF relMSE
                 // at 512x512 cornell 0.0000699 -> 0.0000882, sponza 0.000668 -> 0.000889,
                 // docs/motion.json 0.0000931 -> 0.000142, conference 0.000625 -> 0.000719.)
-                // In a blurred still layer a sample carries its own light where its surface's
-                // filtered light is another point's (and, below, wherever the layer's blur is
-                // large): on another surface than its pixel's primary
-                // one (that surface's filtered light is a film-space neighbour's,
-                // FrameBuffers::surfaceLight), and on the primary surface of a pixel that saw
-                // several where the layer's circle of confusion is at least kOwnLightSlope
-                // pixels (the pixel's filtered light is a mean over its circle of confusion and
-                // the filter's neighbours, which at a silhouette lie on either side of it). The
-                // layer's grid and the rays' disc average the samples' own light over many
-                // samples anyway. Measured, AAF at 512x512, 16 spp, relMSE against the 1024-spp
-                // references (docs/layers.md), the filtered light -> other surfaces' own -> also
-                // the mixed pixels' primary surface's own at |c| >= 2 px: conference 0.000588 ->
-                // 0.000536 -> 0.000485, sponza 0.000656 -> 0.000609 -> 0.000586, bunny 0.000112
-                // -> 0.000110 -> 0.000109, cornell-sphere 0.000129 -> 0.000128 -> 0.000124,
-                // cornell 0.0000709 -> 0.0000712 -> 0.0000712. The mixed pixels' primary
-                // surface at any slope (|c| >= 1 px): cornell 0.0000748, conference 0.000486; at
-                // |c| >= 3 px: conference 0.000528, cornell 0.0000709; in the pixels next to
-                // the mixed ones as well: within 1% (cornell +1%, conference -0.4%);
-                // the other surfaces only at |c| >= 1 / 2 / 4 px: conference 0.000536 / 0.000544
-                // / 0.000582, sponza 0.000627 / 0.000641 / 0.000650; every primary surface's
-                // sample of a blurred layer: conference at 256x256 1.6x worse (the defocused
-                // interiors' variance). A moving layer keeps the filtered light: its radiance is
-                // split over 8 time bins, a bin averages an eighth of the samples
-                // (docs/motion.json 0.0000891 -> 0.0000898 with the other surfaces' own).
-                // Where a layer's slope is kOwnLightAll or more, every sample carries its own
-                // light: the filtered light's second blur is then the larger error. Measured,
-                // AAF relMSE at 384x384 (held out: bunny under twice its aperture focused at
-                // 3, conference under twice its aperture) and 512x512, every pixel at 3 / 4 /
-                // 6 / 8 / 12 px / never: bunny-near 0.0000977 / 0.0000969 / 0.0000962 /
-                // 0.0000961 / 0.000246 / 0.000289 (AAF without layers 0.000140, MC with layers
-                // 0.000105), conference-wide 0.00122 / 0.00120 / 0.00119 / 0.00120 / 0.00121 /
-                // 0.00121, bunny 0.000105 / 0.000104 / 0.000103 / 0.000103 / 0.000109 /
-                // 0.000109, sponza 0.000606 / 0.000596 / 0.000588 / 0.000586 / 0.000586 /
-                // 0.000586, cornell 0.0000923 / 0.0000712 / ... (the same from 4 px on),
-                // cornell-sphere 0.000168 / 0.000124 / ..., conference 0.000534 / 0.000486 /
-                // 0.000485 / ...
+                // In a blurred still layer a sample carries its own light where its filtered
+                // light is another point's or would blur twice:
+                // - on another surface than its pixel's primary one (that surface's filtered
+                //   light is a film-space neighbour's, FrameBuffers::surfaceLight);
+                // - on the primary surface of a pixel that saw several, where the slope is at
+                //   least kOwnLightSlope (the pixel's filtered light is a mean over its circle of
+                //   confusion and over filter neighbours on both sides of the silhouette);
+                // - anywhere the slope is at least kOwnLightAll (the pixel's filtered light,
+                //   already a mean over its circle of confusion, would be blurred again).
+                // The layer's grid and the rays' disc average the own light over many samples.
+                // A moving layer keeps the filtered light: its radiance is split over 8 time bins.
+                // Measured, AAF at 512x512, 16 spp, relMSE with layers before -> after: conference
+                // 0.000588 -> 0.000485, sponza 0.000656 -> 0.000586, bunny 0.000112 -> 0.000103,
+                // cornell-sphere 0.000129 -> 0.000124, cornell 0.0000709 -> 0.0000712; the held-out
+                // docs/bunny-near.json (384x384) 0.000289 -> 0.0000961. The thresholds and the
+                // variants tried (other slopes, moving layers, the pixel's unfiltered light) are
+                // in docs/layers.md, "Own light where the filtered light is another point's" and
+                // "Every sample its own light where the blur is large".
                 auto radianceOf = [&](const Gathered& s, const Layer& l) {
                     const float c = std::abs(l.c);
                     const bool own = !l.sharp && !l.moving &&
