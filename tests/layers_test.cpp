@@ -479,3 +479,40 @@ TEST(Layers, AutoReconstructsForMonteCarloAndAtrousAndABadValueIsAnError) {
         EXPECT_NE(std::string(e.what()).find("--layers"), std::string::npos) << e.what();
     }
 }
+
+TEST(Layers, ConsecutiveSharpLayersMergeAndTheImageStaysTheSame) {
+    // Three near-focus planes (slopes +1.2, +0.4 and -0.4 px, each its own layer at the split's
+    // thresholds but each sharp) share every pixel's samples at random, radiance per sample. A
+    // sharp layer is read at the pixel's own cell, where consecutive ones composite exactly as
+    // one: merged, the image is the same to float rounding with fewer layers a tile.
+    const int W = 128, H = 64;
+    const ViewGeometry view = wideLensView(W, H);
+    const float depths[3] = {1.f / (0.12f + 0.5f), 1.f / (0.04f + 0.5f), 1.f / (0.5f - 0.04f)};
+    ASSERT_NEAR(view.defocusSlope(depths[0]), 1.2f, 1e-4f);
+    ASSERT_NEAR(view.defocusSlope(depths[1]), 0.4f, 1e-4f);
+    ASSERT_NEAR(view.defocusSlope(depths[2]), -0.4f, 1e-4f);
+    LightFieldSamples lf(W, H);
+    const int stage = lf.addStage([](size_t) { return 16u; });
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<float> uni(0.f, 1.f);
+    for (size_t p = 0; p < size_t(W) * H; ++p) {
+        LightFieldSample* run = lf.run(stage, p);
+        for (int k = 0; k < 16; ++k) {
+            const int plane = std::min(2, int(3.f * uni(rng)));
+            run[k] = LightFieldSample::pack({uni(rng), uni(rng)}, concentricDisc(uni(rng), uni(rng)), uni(rng), depths[plane],
+                                            {0.f, 0.f}, Vec3f(1.f), Vec3f(0.1f + 0.3f * float(plane) + 0.2f * uni(rng)), 0);
+        }
+    }
+    filter::LayerOptions apart;
+    apart.mergeSharp = false;
+    filter::LayerStats merged, separate;
+    const Image3f a = filter::reconstructLayers(filter::LayerInput{lf, view, {}}, filter::LayerOptions{}, &merged);
+    const Image3f b = filter::reconstructLayers(filter::LayerInput{lf, view, {}}, apart, &separate);
+    EXPECT_EQ(merged.layersPerTile, 1.0);
+    EXPECT_EQ(separate.layersPerTile, 3.0);
+    EXPECT_EQ(merged.blurredTiles, 0.0);
+    for (size_t i = 0; i < a.size(); ++i) {
+        ASSERT_NEAR(a[i].x, b[i].x, 2e-6f) << i;
+        ASSERT_NEAR(a[i].z, b[i].z, 2e-6f) << i;
+    }
+}

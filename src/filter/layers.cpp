@@ -101,6 +101,17 @@ constexpr Shaped kSegmentShape[16] = {
     {1.10708f, -0.36903f}, {1.07402f, -0.35801f}, {1.02882f, -0.34294f}, {0.96843f, -0.32281f},
     {0.89640f, -0.29880f}, {0.74059f, -0.24641f}, {0.41005f, -0.12985f}, {0.f, 0.f}};
 
+/// The grid's own blur without its Gaussian, variance per axis (pixels^2): the cells a sample is
+/// splatted into (1/12) and the bilinear lookup (1/6).
+constexpr float kCellBlur = 1.f / 12.f + 1.f / 6.f;
+/// Whether a layer of mean slope c, slopes spreading over `spread` and mean screen motion `motion`
+/// (pixels) is sharp: its true blur, a disc of radius |c| (c^2 / 4 per axis) and a segment of
+/// length |m| (m^2 / 12), below the grid's own with the smallest Gaussian.
+inline bool isSharp(float c, float spread, float motion, const LayerOptions& o) {
+    const float trueBlur = 0.25f * sqr(std::abs(c) + 0.5f * spread) + sqr(motion) / 12.f;
+    return trueBlur < kCellBlur + sqr(o.sigmaMin);
+}
+
 struct Layer {
     double sumC = 0, sumMx = 0, sumMy = 0, sumInvDepth = 0;
     float cMin = kInf, cMax = -kInf;
@@ -136,6 +147,7 @@ struct Layer {
         for (int i = 0; i <= kShearSteps; ++i) shearTable[i] = shear(cMin + step * float(i));
     }
     bool sharp = true;
+    bool sharpRun = false;  // several still layers, each sharp, merged into one (splitLayers)
     float sigma = 0;
     int timeBins = 1;
     // The grid: cell (i, j) covers the pixel [gx0 + i, gx0 + i + 1) x [gy0 + j, gy0 + j + 1).
@@ -209,6 +221,7 @@ struct Split {
         std::vector<int> count, binLayer;
         std::vector<double> sumC, sumMx, sumMy, sumInvDepth;
         std::vector<float> cMin, cMax;
+        std::vector<uint8_t> sharpRun;  // per layer of the class: a merged run of sharp layers
         int bin(float c) const { return std::clamp(int((cHi - c) / binW), 0, bins - 1); }
     };
     Histogram hist[2];
@@ -220,6 +233,54 @@ struct Split {
         return rank[h.base + h.binLayer[h.bin(s.c)]];
     }
 };
+
+/// Merges consecutive still layers (runs of the histogram `h`'s bins, numbered by slope) that
+/// would each be sharp into one, and renumbers the bins' layers; returns the new count and marks
+/// the merged layers in h.sharpRun. Exact: a sharp layer is looked up at the pixel's own cell,
+/// where two consecutive ones composite to (N_A L_A + N_B L_B) / D, A's alpha N_A / D over B's
+/// N_B / (D - N_A) (D the samples of both and of everything behind), which is the merged
+/// layer's alpha (N_A + N_B) / D times its mean light. So they take one slot of the layer budget
+/// (LayerOptions::maxLayers) instead of several, and the budget goes to the blurred layers,
+/// whose visibility it resolves.
+int mergeSharpRuns(Split::Histogram& h, int nLayers, const LayerOptions& o) {
+    struct Stats {
+        double count = 0, c = 0, mx = 0, my = 0;
+        float cMin = kInf, cMax = -kInf;
+    };
+    std::vector<Stats> st(static_cast<size_t>(nLayers));
+    for (int b = 0; b < h.bins; ++b) {
+        if (h.count[b] == 0) continue;
+        Stats& s = st[size_t(h.binLayer[b])];
+        s.count += h.count[b];
+        s.c += h.sumC[b];
+        s.mx += h.sumMx[b];
+        s.my += h.sumMy[b];
+        s.cMin = std::min(s.cMin, h.cMin[b]);
+        s.cMax = std::max(s.cMax, h.cMax[b]);
+    }
+    std::vector<int> renumber(static_cast<size_t>(nLayers));
+    std::vector<uint8_t> run;
+    int merged = 0;
+    bool previousSharp = false;
+    for (int k = 0; k < nLayers; ++k) {
+        const Stats& s = st[size_t(k)];
+        const double inv = 1.0 / std::max(1.0, s.count);
+        const float mx = float(s.mx * inv), my = float(s.my * inv);
+        const bool sharp = isSharp(float(s.c * inv), s.cMax - s.cMin, std::sqrt(mx * mx + my * my), o);
+        if (sharp && previousSharp) {
+            run.back() = 1;
+        } else {
+            ++merged;
+            run.push_back(0);
+        }
+        renumber[size_t(k)] = merged - 1;
+        previousSharp = sharp;
+    }
+    for (int b = 0; b < h.bins; ++b)
+        if (h.count[b] > 0) h.binLayer[b] = renumber[size_t(h.binLayer[b])];
+    h.sharpRun = run;
+    return merged;
+}
 
 /// Splits the tile's samples into layers, front to back (see layers.h, step 1).
 /// `range[moving]`: the slopes of the still and the moving samples. One pass over the samples,
@@ -303,11 +364,16 @@ void splitLayers(const std::vector<Gathered>& g, const SlopeRange (&range)[2], c
                 h.binLayer[b] = nLayers - 1;
                 last = b;
             }
+            h.sharpRun.assign(size_t(nLayers), 0);
+            if (moving == 0 && o.mergeSharp) nLayers = mergeSharpRuns(h, nLayers, o);
             if (int(layers.size()) + nLayers <= o.maxLayers || nLayers <= 1) break;
         }
         h.base = int(layers.size());
         layers.resize(h.base + nLayers);
-        for (int k = h.base; k < h.base + nLayers; ++k) layers[k].moving = bool(moving);
+        for (int k = h.base; k < h.base + nLayers; ++k) {
+            layers[k].moving = bool(moving);
+            layers[k].sharpRun = h.sharpRun[size_t(k - h.base)] != 0;
+        }
         // A layer's statistics are those of its bins (summed bin by bin: the means can differ
         // from a sample-by-sample sum in the last bits of the double sums).
         for (int b = 0; b < h.bins; ++b) {
@@ -731,9 +797,8 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                     // it they give the true blur, a disc of radius |c| (c^2 / 4 per axis) and a
                     // segment of length |m| (m^2 / 12); a layer whose true blur is below the
                     // grid's own with the smallest sigma is sharp.
-                    constexpr float cellBlur = 1.f / 12.f + 1.f / 6.f;
-                    const float trueBlur = 0.25f * sqr(std::abs(l.c) + 0.5f * spread) + sqr(motion) / 12.f;
-                    l.sharp = trueBlur < cellBlur + sqr(o.sigmaMin);
+                    constexpr float cellBlur = kCellBlur;
+                    l.sharp = l.sharpRun || isSharp(l.c, spread, motion, o);
                     l.rayC = l.c, l.rayMx = l.mx, l.rayMy = l.my;
                     int lm = 0;
                     if (!l.sharp) {
