@@ -26,10 +26,10 @@
 //    shutter time for a moving layer (a moving surface's shading changes as it moves); and the
 //    sum of its samples' slopes. A sample in front of the layer tells nothing about it, so it is
 //    left out of D: alpha = N / D is the layer's coverage where it is not hidden. The grids are
-//    smoothed with a Gaussian of sigma = clamp(0.15 |c_l|, 0.5, 2) pixels (at least half the
-//    slopes' spread); cells without weight (the layer hidden there) are filled from their
-//    neighbours. A layer whose true blur (a disc of radius |c|, a segment of length |m|) is
-//    below the grid's own is "sharp": not reprojected, its grid its pixels' own samples.
+//    smoothed with a Gaussian of sigma = clamp(0.15 |c_l|, 0.5, 2) pixels; cells without
+//    weight (the layer hidden there) are filled from their neighbours. A layer whose true blur
+//    (a disc of radius |c|, a segment of length |m|) is below the grid's own is "sharp": not
+//    reprojected, its grid its pixels' own samples.
 // 3. Each pixel is the mean of 32 reconstruction rays (x, y, u, v, t), a 5D Kronecker sequence
 //    shifted per pixel, so that pixel, lens and shutter are stratified jointly. Front to back, a
 //    ray takes each layer's alpha and premultiplied radiance at its shear, with the slope of the
