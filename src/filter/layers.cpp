@@ -128,6 +128,12 @@ struct Layer {
     // cornell).
     float rayC = 0, rayC2 = 0, rayMx = 0, rayMy = 0, rayT2 = 0;
     float gridBlur = 0;  // the grid's own blur, variance per axis (pixels^2)
+    // A blurred moving layer's rays are sheared by motionScale times the screen motion of the
+    // surface they find there (motionGrid: per cell the mean motion of the layer's samples,
+    // smoothed; the layer's mean where it has none): a sphere's front moves faster on screen
+    // than its silhouette, and the layer's mean motion stretched its blur (layers.cpp, the splat).
+    float motionScale = 1, maxMotion = 0;
+    std::vector<float> motionGrid;
     static constexpr int kShearSteps = 8;
     float shearFrom = 0, shearScale = 0;  // the table's index: (c - shearFrom) shearScale
     Shaped shearTable[kShearSteps + 1];
@@ -609,20 +615,38 @@ template <bool kFollow, bool kMoving>
 bool traceBlurred(const Layer& l, int index, Rays& ray, int j0, int j1) {
     const int cs = l.cellStride(), bins = l.timeBins;
     const float* cell = l.cell.data();
+    const bool followMotion = kMoving && !l.motionGrid.empty();
+    const float* motion = l.motionGrid.data();
     int partial = 0;
 #pragma omp simd reduction(| : partial)
     for (int j = j0; j < j1; ++j) {
         const float dt = ray.dt[j];
         const float st = dt * (1.f + l.rayT2 * 4.f * dt * dt);
-        const float mox = l.rayMx * st, moy = l.rayMy * st;
+        float mox = l.rayMx * st, moy = l.rayMy * st;
         float cRay = l.rayC + l.rayC2 * ray.u2[j];
-        if constexpr (kFollow) {
+        if (kFollow || followMotion) {
+            // One fixed-point step: the slope and the motion of the surface found at the
+            // layer's shear.
             const Bilinear b = bilinear(l, {ray.px[j] + cRay * ray.ux[j] - mox, ray.py[j] - cRay * ray.uy[j] - moy});
-            float slope = 0;
+            if constexpr (kFollow) {
+                float slope = 0;
 #pragma GCC unroll 4
-            for (int k = 0; k < 4; ++k) slope += b.w[k] * cell[b.cell[k] * cs + cs - 1];
-            const Shaped sh = lerp(l.shearTable, clampValue((slope - l.shearFrom) * l.shearScale, 0.f, float(Layer::kShearSteps) - 1e-3f));
-            cRay = sh.a + sh.b * ray.u2[j];
+                for (int k = 0; k < 4; ++k) slope += b.w[k] * cell[b.cell[k] * cs + cs - 1];
+                const Shaped sh = lerp(l.shearTable, clampValue((slope - l.shearFrom) * l.shearScale, 0.f, float(Layer::kShearSteps) - 1e-3f));
+                cRay = sh.a + sh.b * ray.u2[j];
+            }
+            if constexpr (kMoving) {
+                if (followMotion) {
+                    float mx = 0, my = 0;
+#pragma GCC unroll 4
+                    for (int k = 0; k < 4; ++k) {
+                        mx += b.w[k] * motion[2 * b.cell[k]];
+                        my += b.w[k] * motion[2 * b.cell[k] + 1];
+                    }
+                    mox = l.motionScale * mx * st;
+                    moy = l.motionScale * my * st;
+                }
+            }
         }
         const Bilinear b = bilinear(l, {ray.px[j] + cRay * ray.ux[j] - mox, ray.py[j] - cRay * ray.uy[j] - moy});
         const TimeLerp tl = kMoving ? timeLerp(bins, dt + 0.5f) : TimeLerp{0, 0, 0.f};
@@ -818,6 +842,7 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                             const Shaped k = motion > 0 ? shaped(std::sqrt(rest) / motion, kSegmentShape, 0.02f, 0.288675f) : Shaped{};
                             l.rayMx = l.mx * k.a;
                             l.rayMy = l.my * k.a;
+                            l.motionScale = k.a;
                             l.rayT2 = k.a > 0 ? k.b / k.a : 0.f;
                         }
                         lm = int(std::ceil(std::abs(l.c) + 0.5f * motion + 3.f * l.sigma)) + 1;
@@ -834,12 +859,20 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                 }
                 blurredTotal += anyBlurred ? 1 : 0;
                 // Splat: N and D at the layer's shear, W and the radiance at the sample's own.
+                bool anyMotionGrid = false;
+                std::vector<std::vector<float>> motionAcc(layers.size());
+                for (size_t k = 0; k < layers.size(); ++k)
+                    if (layers[k].moving && !layers[k].sharp && layers[k].motionScale > 0.f) {
+                        motionAcc[k].assign(size_t(layers[k].gw) * layers[k].gh * 3, 0.f);
+                        anyMotionGrid = true;
+                    }
                 for (const Gathered& s : g) {
                     const int sl = split.layerOf(s);
                     // D of the layers in front, at their shear: where this sample shows that
                     // they do not cover.
                     for (int k = 0; k < sl; ++k) {
                         Layer& l = layers[k];
+                        if (!motionAcc[k].empty()) continue;
                         const int ci = l.cellIndex(l.sharpPosition(s));
                         if (ci >= 0) l.accD[ci] += 1.f;
                     }
@@ -855,12 +888,48 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                     l.acc[size_t(ci) * l.accStride()] += 1.f;
                     l.accD[ci] += 1.f;
                     l.acc[size_t(ci + 1) * l.accStride() - 1] += s.c;
+                    if (!motionAcc[size_t(sl)].empty()) {
+                        float* m = &motionAcc[size_t(sl)][size_t(ci) * 3];
+                        m[0] += 1.f, m[1] += s.mx, m[2] += s.my;
+                    }
                     const Vec3f radiance = radianceOf(s, l);
                     float* a = &l.acc[size_t(ci) * l.accStride() + 1 + 4 * l.timeBin(s.t)];
                     a[0] += 1.f;
                     a[1] += radiance.x;
                     a[2] += radiance.y;
                     a[3] += radiance.z;
+                }
+                if (anyMotionGrid) {
+                    for (size_t k = 0; k < layers.size(); ++k) {
+                        if (motionAcc[k].empty()) continue;
+                        Layer& l = layers[k];
+                        smooth(motionAcc[k], l.gw, l.gh, 3, l.sigma);
+                        l.motionGrid.resize(size_t(l.gw) * l.gh * 2);
+                        float reach = 0;
+                        for (size_t i = 0; i < size_t(l.gw) * l.gh; ++i) {
+                            float* m = &motionAcc[k][i * 3];
+                            if (m[0] >= 0.05f) m[1] /= m[0], m[2] /= m[0];
+                            else m[1] = l.mx, m[2] = l.my;
+                            l.motionGrid[2 * i] = m[1];
+                            l.motionGrid[2 * i + 1] = m[2];
+                            reach = std::max(reach, m[1] * m[1] + m[2] * m[2]);
+                        }
+                        l.maxMotion = std::sqrt(reach);
+                    }
+                    for (const Gathered& s : g) {
+                        const int sl = split.layerOf(s);
+                        for (int k = 0; k < sl; ++k) {
+                            if (motionAcc[k].empty()) continue;
+                            Layer& l = layers[k];
+                            const Vec2f p0 = l.sharpPosition(s);
+                            const Bilinear b = bilinear(l, p0);
+                            float mx = 0, my = 0;
+                            for (int q = 0; q < 4; ++q) mx += b.w[q] * motionAcc[k][size_t(b.cell[q]) * 3 + 1], my += b.w[q] * motionAcc[k][size_t(b.cell[q]) * 3 + 2];
+                            const float dt = s.t - 0.5f;
+                            const int ci = l.cellIndex({s.x + l.c * s.u - mx * dt, s.y - l.c * s.v - my * dt});
+                            if (ci >= 0) l.accD[ci] += 1.f;
+                        }
+                    }
                 }
                 for (Layer& l : layers) {
                     if (!l.sharp) {
@@ -872,7 +941,7 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                     l.accD = std::vector<float>();
                     l.buildCovered();
                     l.rayReach = std::max({std::abs(l.cMin), std::abs(l.cMax), std::abs(l.rayC), std::abs(l.rayC + l.rayC2)}) +
-                                 0.5f * std::sqrt(l.rayMx * l.rayMx + l.rayMy * l.rayMy);
+                                 0.5f * std::max(std::sqrt(l.rayMx * l.rayMx + l.rayMy * l.rayMy), l.motionScale * l.maxMotion);
                 }
                 // A layer a pixel's rays can see; a sharp still layer is the same for every ray
                 // (its pixel's cell), looked up once.

@@ -32,9 +32,11 @@
 //    reprojected, its grid its pixels' own samples.
 // 3. Each pixel is the mean of 32 reconstruction rays (x, y, u, v, t), a 5D Kronecker sequence
 //    shifted per pixel, so that pixel, lens and shutter are stratified jointly. Front to back, a
-//    ray takes each layer's alpha and premultiplied radiance at its shear, with the slope of the
-//    surface it finds there (one fixed-point step: a slanted floor's slope changes across the
-//    tile), shaped so that the grid's own blur (cells, Gaussian, bilinear lookup) over the
+//    ray takes each layer's alpha and premultiplied radiance at its shear, with the slope and
+//    the screen motion of the surface it finds there (one fixed-point step: a slanted floor's
+//    slope changes across the tile, and a sphere's front moves faster on screen than its
+//    silhouette; a moving layer keeps its samples' mean motion per cell, and its D counts the
+//    samples behind it at that motion too), shaped so that the grid's own blur (cells, Gaussian, bilinear lookup) over the
 //    rays' disc (segment) gives the true disc's (segment's) edge profile as nearly as a
 //    near-Gaussian allows (rays drawn towards the rim: layers.cpp, Shaped): C += T alpha L, T *=
 //    1 - alpha.
