@@ -240,6 +240,17 @@ struct Split {
     }
 };
 
+/// Adds bin b of `h` to a layer's sums.
+void addBin(Layer& l, const Split::Histogram& h, int b) {
+    l.count += h.count[b];
+    l.sumC += h.sumC[b];
+    l.sumMx += h.sumMx[b];
+    l.sumMy += h.sumMy[b];
+    l.sumInvDepth += h.sumInvDepth[b];
+    l.cMin = std::min(l.cMin, h.cMin[b]);
+    l.cMax = std::max(l.cMax, h.cMax[b]);
+}
+
 /// Merges consecutive still layers (runs of the histogram `h`'s bins, numbered by slope) that
 /// would each be sharp into one, and renumbers the bins' layers; returns the new count and marks
 /// the merged layers in h.sharpRun. Exact: a sharp layer is looked up at the pixel's own cell,
@@ -249,30 +260,18 @@ struct Split {
 /// (LayerOptions::maxLayers) instead of several, and the budget goes to the blurred layers,
 /// whose visibility it resolves.
 int mergeSharpRuns(Split::Histogram& h, int nLayers, const LayerOptions& o) {
-    struct Stats {
-        double count = 0, c = 0, mx = 0, my = 0;
-        float cMin = kInf, cMax = -kInf;
-    };
-    std::vector<Stats> st(static_cast<size_t>(nLayers));
-    for (int b = 0; b < h.bins; ++b) {
-        if (h.count[b] == 0) continue;
-        Stats& s = st[size_t(h.binLayer[b])];
-        s.count += h.count[b];
-        s.c += h.sumC[b];
-        s.mx += h.sumMx[b];
-        s.my += h.sumMy[b];
-        s.cMin = std::min(s.cMin, h.cMin[b]);
-        s.cMax = std::max(s.cMax, h.cMax[b]);
-    }
+    std::vector<Layer> st(static_cast<size_t>(nLayers));
+    for (int b = 0; b < h.bins; ++b)
+        if (h.count[b] > 0) addBin(st[size_t(h.binLayer[b])], h, b);
     std::vector<int> renumber(static_cast<size_t>(nLayers));
     std::vector<uint8_t> run;
     int merged = 0;
     bool previousSharp = false;
     for (int k = 0; k < nLayers; ++k) {
-        const Stats& s = st[size_t(k)];
-        const double inv = 1.0 / std::max(1.0, s.count);
-        const float mx = float(s.mx * inv), my = float(s.my * inv);
-        const bool sharp = isSharp(float(s.c * inv), s.cMax - s.cMin, std::sqrt(mx * mx + my * my), o);
+        const Layer& s = st[size_t(k)];
+        const double inv = 1.0 / std::max(1, s.count);
+        const float mx = float(s.sumMx * inv), my = float(s.sumMy * inv);
+        const bool sharp = isSharp(float(s.sumC * inv), s.cMax - s.cMin, std::sqrt(mx * mx + my * my), o);
         if (sharp && previousSharp) {
             run.back() = 1;
         } else {
@@ -382,17 +381,8 @@ void splitLayers(const std::vector<Gathered>& g, const SlopeRange (&range)[2], c
         }
         // A layer's statistics are those of its bins (summed bin by bin: the means can differ
         // from a sample-by-sample sum in the last bits of the double sums).
-        for (int b = 0; b < h.bins; ++b) {
-            if (h.count[b] == 0) continue;
-            Layer& l = layers[h.base + h.binLayer[b]];
-            l.count += h.count[b];
-            l.sumC += h.sumC[b];
-            l.sumMx += h.sumMx[b];
-            l.sumMy += h.sumMy[b];
-            l.sumInvDepth += h.sumInvDepth[b];
-            l.cMin = std::min(l.cMin, h.cMin[b]);
-            l.cMax = std::max(l.cMax, h.cMax[b]);
-        }
+        for (int b = 0; b < h.bins; ++b)
+            if (h.count[b] > 0) addBin(layers[h.base + h.binLayer[b]], h, b);
     }
     for (Layer& l : layers) {
         const double inv = 1.0 / std::max(1, l.count);
