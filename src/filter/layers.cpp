@@ -175,10 +175,11 @@ struct Layer {
     int accStride() const { return 2 + 4 * timeBins; }   // ... and last the sum of the samples' slopes
     int cellStride() const { return 2 + 3 * timeBins; }  // ... and last the samples' mean slope there
 
-    Vec2f sharpPosition(const Gathered& s) const {
-        if (sharp) return {s.x, s.y};
+    Vec2f sharpPosition(const Gathered& s) const { return sharp ? Vec2f{s.x, s.y} : sharpPosition(s, mx, my); }
+    /// The blurred layer's shear of sample s with the screen motion (motionX, motionY).
+    Vec2f sharpPosition(const Gathered& s, float motionX, float motionY) const {
         const float dt = s.t - 0.5f;
-        return {s.x + c * s.u - mx * dt, s.y - c * s.v - my * dt};
+        return {s.x + c * s.u - motionX * dt, s.y - c * s.v - motionY * dt};
     }
     int cellIndex(Vec2f p) const {
         const int i = int(std::floor(p.x)) - gx0, j = int(std::floor(p.y)) - gy0;
@@ -546,6 +547,17 @@ struct Bilinear {
     const int c00 = j0 * l.gw + i0;
     return {{c00, c00 + 1, c00 + l.gw, c00 + l.gw + 1}, {(1 - ax) * (1 - ay), ax * (1 - ay), (1 - ax) * ay, ax * ay}};
 }
+/// A moving layer's mean motion (motionGrid) at a bilinear lookup.
+[[gnu::always_inline]] inline Vec2f motionAt(const Layer& l, const Bilinear& b) {
+    const float* motion = l.motionGrid.data();
+    float mx = 0, my = 0;
+#pragma GCC unroll 4
+    for (int k = 0; k < 4; ++k) {
+        mx += b.w[k] * motion[2 * b.cell[k]];
+        my += b.w[k] * motion[2 * b.cell[k] + 1];
+    }
+    return {mx, my};
+}
 /// Shutter time t between the centres of a layer's `bins` time bins: bins b0 and b1 (the same
 /// for a still layer, one bin, or in the last bin's half) and the weight `at` of b1.
 struct TimeLerp {
@@ -606,7 +618,6 @@ bool traceBlurred(const Layer& l, int index, Rays& ray, int j0, int j1) {
     const int cs = l.cellStride(), bins = l.timeBins;
     const float* cell = l.cell.data();
     const bool followMotion = kMoving && !l.motionGrid.empty();
-    const float* motion = l.motionGrid.data();
     int partial = 0;
 #pragma omp simd reduction(| : partial)
     for (int j = j0; j < j1; ++j) {
@@ -627,14 +638,9 @@ bool traceBlurred(const Layer& l, int index, Rays& ray, int j0, int j1) {
             }
             if constexpr (kMoving) {
                 if (followMotion) {
-                    float mx = 0, my = 0;
-#pragma GCC unroll 4
-                    for (int k = 0; k < 4; ++k) {
-                        mx += b.w[k] * motion[2 * b.cell[k]];
-                        my += b.w[k] * motion[2 * b.cell[k] + 1];
-                    }
-                    mox = l.motionScale * mx * st;
-                    moy = l.motionScale * my * st;
+                    const Vec2f m = motionAt(l, b);
+                    mox = l.motionScale * m.x * st;
+                    moy = l.motionScale * m.y * st;
                 }
             }
         }
@@ -811,7 +817,6 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                     // it they give the true blur, a disc of radius |c| (c^2 / 4 per axis) and a
                     // segment of length |m| (m^2 / 12); a layer whose true blur is below the
                     // grid's own with the smallest sigma is sharp.
-                    constexpr float cellBlur = kCellBlur;
                     l.sharp = l.sharpRun || isSharp(l.c, spread, motion, o);
                     l.rayC = l.c, l.rayMx = l.mx, l.rayMy = l.my;
                     int lm = 0;
@@ -820,7 +825,7 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                         // spread, as it was, over-blurred the layers a tile's budget had widened: AAF
                         // relMSE on docs/conference-wide.json with a budget of 8 layers 0.000927 -> 0.000667.)
                         l.sigma = std::clamp(o.sigmaScale * std::abs(l.c), o.sigmaMin, o.sigmaMax);
-                        const float gridBlur = cellBlur + sqr(l.sigma);
+                        const float gridBlur = kCellBlur + sqr(l.sigma);
                         l.gridBlur = gridBlur;
                         if (l.followsSlope()) l.buildShearTable();
                         if (0.25f * sqr(l.c) >= gridBlur) {
@@ -911,12 +916,8 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                         for (int k = 0; k < sl; ++k) {
                             if (motionAcc[k].empty()) continue;
                             Layer& l = layers[k];
-                            const Vec2f p0 = l.sharpPosition(s);
-                            const Bilinear b = bilinear(l, p0);
-                            float mx = 0, my = 0;
-                            for (int q = 0; q < 4; ++q) mx += b.w[q] * motionAcc[k][size_t(b.cell[q]) * 3 + 1], my += b.w[q] * motionAcc[k][size_t(b.cell[q]) * 3 + 2];
-                            const float dt = s.t - 0.5f;
-                            const int ci = l.cellIndex({s.x + l.c * s.u - mx * dt, s.y - l.c * s.v - my * dt});
+                            const Vec2f m = motionAt(l, bilinear(l, l.sharpPosition(s)));
+                            const int ci = l.cellIndex(l.sharpPosition(s, m.x, m.y));
                             if (ci >= 0) l.accD[ci] += 1.f;
                         }
                     }

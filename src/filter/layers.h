@@ -36,10 +36,10 @@
 //    the screen motion of the surface it finds there (one fixed-point step: a slanted floor's
 //    slope changes across the tile, and a sphere's front moves faster on screen than its
 //    silhouette; a moving layer keeps its samples' mean motion per cell, and its D counts the
-//    samples behind it at that motion too), shaped so that the grid's own blur (cells, Gaussian, bilinear lookup) over the
-//    rays' disc (segment) gives the true disc's (segment's) edge profile as nearly as a
-//    near-Gaussian allows (rays drawn towards the rim: layers.cpp, Shaped): C += T alpha L, T *=
-//    1 - alpha.
+//    samples behind it at that motion too), shaped so that the grid's own blur (cells,
+//    Gaussian, bilinear lookup) over the rays' disc (segment) gives the true disc's (segment's)
+//    edge profile as nearly as a near-Gaussian allows (rays drawn towards the rim: layers.cpp,
+//    Shaped): C += T alpha L, T *= 1 - alpha.
 //    Light the layers leave uncovered (a hole no sample saw) is the mean of what they cover.
 //    Where every layer of the tile is sharp, one ray at the pixel gives the same: the pixel's
 //    own samples composited by surface, as without layers. A pixel whose 32 rays straddle
