@@ -345,6 +345,26 @@ TEST(MaafComponents, NoIndirectOuterComponentsWhereTheNearestBounceHitIsWithinTh
     }
 }
 
+TEST(MaafComponents, DilateBoxMarksEveryPixelWithinTheRadiusOfAMarkedOne) {
+    // The region MAAF's sparse pipeline computes in: against a brute-force search, on scattered
+    // marks (some at the borders) and radii from 0 to beyond the image.
+    const int W = 23, H = 17;
+    std::mt19937 rng(5);
+    Image<uint8_t> mask(W, H);
+    for (size_t i = 0; i < mask.size(); ++i) mask[i] = (rng() % 29) == 0;
+    mask(0, 0) = mask(W - 1, 8) = 1;
+    for (int radius : {0, 1, 3, 10, 30}) {
+        const Image<uint8_t> region = dilateBox(mask, radius);
+        for (int y = 0; y < H; ++y)
+            for (int x = 0; x < W; ++x) {
+                bool near = false;
+                for (int yy = std::max(0, y - radius); yy <= std::min(H - 1, y + radius); ++yy)
+                    for (int xx = std::max(0, x - radius); xx <= std::min(W - 1, x + radius); ++xx) near = near || mask(xx, yy);
+                EXPECT_EQ(region(x, y), near ? 1 : 0) << x << "," << y << " radius " << radius;
+            }
+    }
+}
+
 TEST(MaafComponents, OneComponentIsTheAxisAlignedFilterOfEq2) {
     WedgeShape w;
     w.omegaYMax = 4;

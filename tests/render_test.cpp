@@ -571,6 +571,39 @@ TEST(Render, MaafIsAafWhereNoFilterHasOuterComponents) {
     EXPECT_NE(0, std::memcmp(outer.color.data(), aaf.color.data(), aaf.color.size() * sizeof(Vec3f)));
 }
 
+TEST(Render, MaafSparseComponentsGiveTheDenseImage) {
+    // By default MAAF decides first which pixels' indirect filters have outer components
+    // (filter::maafIndirectOuter) and computes the frames, components and accumulations only
+    // within the filter's window of them; --maaf-dense computes them in every pixel. Cornell at
+    // 96x96 (a lens, a grazing floor and ceiling: a few hundred pixels with outer components):
+    // the same pixels, the same image bytes, less accumulator memory; also with a wider window
+    // (the region follows it) and with seven components.
+    scene::SceneDesc desc = scene::loadScene("cornell");
+    desc.camera.width = desc.camera.height = 96;
+    const scene::Scene scene(std::move(desc));
+    for (auto [radius, components] : {std::pair{10, 5}, std::pair{16, 5}, std::pair{10, 7}}) {
+        render::RenderOptions o;
+        o.quiet = true;
+        o.method = "maaf";
+        o.spp = 4;
+        o.seed = 9;
+        o.maafRadius = radius;
+        o.maafComponents = components;
+        const render::RenderResult sparse = render::render(scene, o);
+        o.maafSparse = false;
+        const render::RenderResult dense = render::render(scene, o);
+        const double outer = sparse.figure("maaf_outer_component_pixels").value_or(-1);
+        EXPECT_GT(outer, 20) << "radius " << radius << ", " << components << " components";
+        EXPECT_LT(outer, 0.5 * 96 * 96);  // a sparse region, or the test shows nothing
+        EXPECT_EQ(outer, dense.figure("maaf_outer_component_pixels").value_or(-2));
+        EXPECT_LT(sparse.figure("maaf_accumulator_bytes").value_or(0), dense.figure("maaf_accumulator_bytes").value_or(0));
+        EXPECT_EQ(sparse.rays, dense.rays);
+        ASSERT_EQ(sparse.color.size(), dense.color.size());
+        EXPECT_EQ(0, std::memcmp(sparse.color.data(), dense.color.data(), dense.color.size() * sizeof(Vec3f)))
+            << "radius " << radius << ", " << components << " components";
+    }
+}
+
 namespace {
 /// A path sample on surface `object` at depth 1 with the given direct light (albedo 1).
 render::TracedSample surfaceSample(uint32_t object, float light) {

@@ -54,6 +54,9 @@ void addMethodFlags(CLI::App& cmd, render::RenderOptions& r) {
     cmd.add_flag("--maaf-keep-records", r.maafKeepRecords,
                  "maaf: keep every pixel's initial samples instead of tracing the outer-component pixels' again "
                  "(the same image; more memory, faster only where the memory was touched before)");
+    cmd.add_flag("!--maaf-dense", r.maafSparse,
+                 "maaf: compute the indirect light's frames, components and accumulations in every pixel, not only "
+                 "within the filter's window of the pixels with outer components (the same image; for checks)");
     cmd.add_option("--maaf-weights", r.maafWeights,
                    "maaf: component weights mu_p: the sampling densities' spectra (default), eq. 10's Gaussian, or 1")
         ->check(CLI::IsMember({"sampling", "eq10", "unit"}));

@@ -31,7 +31,49 @@ AxisFrame makeFrame(const Vec3f& s1, const Vec3f& s2, const Vec3f& fallback1, co
 
 }  // namespace
 
-FilterFrames computeFrames(const FrameBuffers& fb, const ViewGeometry& view, bool withDirect) {
+namespace {
+
+/// World steps s1, s2 of one pixel step along image x and y in pixel p's tangent plane; false
+/// where the pixel has no surface.
+bool tangentSteps(const FrameBuffers& fb, const ViewGeometry& view, size_t p, Vec3f& s1, Vec3f& s2) {
+    const Vec3f n = fb.normal[p];
+    const float depth = fb.depth[p];
+    if (fb.object[p] < 0 || depth <= 0) return false;
+    // dP/dx for a pinhole ray D = forward + ... (D . forward = 1) hitting the tangent plane:
+    // dP = (depth / f) (e - D (n . e) / (n . D)), e = right or down.
+    const Vec3f down = -view.up;
+    Vec3f P = fb.position[p];
+    Vec3f D = (P - view.cameraPosition) / depth;
+    float nD = dot(n, D);
+    float lenD = length(D);
+    if (std::abs(nD) < 0.1f * lenD) nD = std::copysign(0.1f * lenD, nD == 0 ? 1.f : nD);  // grazing: cap the stretch
+    float scale = depth / view.focalPixels;
+    s1 = (view.right - D * (dot(n, view.right) / nD)) * scale;
+    s2 = (down - D * (dot(n, down) / nD)) * scale;
+    return true;
+}
+
+}  // namespace
+
+float indirectStepBound(const FrameBuffers& fb, const ViewGeometry& view, size_t p) {
+    const Vec3f n = fb.normal[p];
+    const float depth = fb.depth[p];
+    if (fb.object[p] < 0 || depth <= 0) return 1.f;
+    // |s_k| = scale |e - D (n . e) / (n . D)| <= scale (1 + |D| |n| / |n . D|) for a unit e,
+    // with n . D capped as tangentSteps caps it; a 1% margin for the rounding of either.
+    const Vec3f D = (fb.position[p] - view.cameraPosition) / depth;
+    const float lenD = length(D);
+    const float nD = std::max(std::abs(dot(n, D)), 0.1f * lenD);
+    return 1.01f * (depth / view.focalPixels) * (1.f + lenD * length(n) / std::max(nD, 1e-30f));
+}
+
+AxisFrame indirectFrame(const FrameBuffers& fb, const ViewGeometry& view, size_t p) {
+    Vec3f s1, s2;
+    if (!tangentSteps(fb, view, p, s1, s2)) return {{view.right, -view.up}, {1, 1}};
+    return makeFrame(s1, s2, view.right, fb.normal[p]);
+}
+
+FilterFrames computeFrames(const FrameBuffers& fb, const ViewGeometry& view, bool withDirect, const Image<uint8_t>* where) {
     FilterFrames ff;
     if (withDirect) ff.direct = Image<AxisFrame>(fb.width, fb.height);
     ff.indirect = Image<AxisFrame>(fb.width, fb.height);
@@ -43,26 +85,18 @@ FilterFrames computeFrames(const FrameBuffers& fb, const ViewGeometry& view, boo
     parallelRows(fb.height, [&](int y) {
         for (int x = 0; x < fb.width; ++x) {
             size_t p = size_t(y) * fb.width + x;
-            Vec3f n = fb.normal[p];
-            float depth = fb.depth[p];
-            if (fb.object[p] < 0 || depth <= 0) {
+            if (where && !(*where)[p]) continue;
+            Vec3f s1, s2;
+            if (!tangentSteps(fb, view, p, s1, s2)) {
                 if (withDirect) ff.direct[p] = {{view.right, down}, {1, 1}};
                 ff.indirect[p] = {{view.right, down}, {1, 1}};
                 continue;
             }
-            // dP/dx for a pinhole ray D = forward + ... (D . forward = 1) hitting the tangent plane:
-            // dP = (depth / f) (e - D (n . e) / (n . D)), e = right or down.
-            Vec3f P = fb.position[p];
-            Vec3f D = (P - view.cameraPosition) / depth;
-            float nD = dot(n, D);
-            float lenD = length(D);
-            if (std::abs(nD) < 0.1f * lenD) nD = std::copysign(0.1f * lenD, nD == 0 ? 1.f : nD);  // grazing: cap the stretch
-            float scale = depth / view.focalPixels;
-            Vec3f s1 = (view.right - D * (dot(n, view.right) / nD)) * scale;
-            Vec3f s2 = (down - D * (dot(n, down) / nD)) * scale;
+            const Vec3f n = fb.normal[p];
             ff.indirect[p] = makeFrame(s1, s2, view.right, n);
             if (!withDirect) continue;
             // The light's plane; a sphere light's is the one facing this receiver.
+            const Vec3f P = fb.position[p];
             Vec3f lp = nl, lx = la;
             if (sphere) {
                 lp = normalize(view.lights[ff.light].center - P);

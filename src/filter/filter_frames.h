@@ -25,8 +25,17 @@ struct FilterFrames {
 };
 
 /// withDirect = false leaves `direct` empty (a caller that filters only the indirect light
-/// with these frames: MAAF in AAF's pipeline).
-FilterFrames computeFrames(const FrameBuffers& fb, const ViewGeometry& view, bool withDirect = true);
+/// with these frames: MAAF in AAF's pipeline). With `where`, only the pixels where it is
+/// non-zero get their frames (the others keep the image's default: a caller that reads only
+/// those, MAAF's sparse components).
+FilterFrames computeFrames(const FrameBuffers& fb, const ViewGeometry& view, bool withDirect = true,
+                           const Image<uint8_t>* where = nullptr);
+
+/// Pixel p's indirect frame, as computeFrames gives it, computed alone.
+AxisFrame indirectFrame(const FrameBuffers& fb, const ViewGeometry& view, size_t p);
+/// At least both steps of pixel p's indirect frame, for less work than the frame (a quick
+/// rejection of pixels whose steps are too short for something).
+float indirectStepBound(const FrameBuffers& fb, const ViewGeometry& view, size_t p);
 
 /// The light the direct-light filters take their plane and bandwidth from: the most powerful.
 int dominantLight(const ViewGeometry& view);

@@ -70,8 +70,48 @@ int maafFitPairs(double omegaX, double step, const MaafOptions& o) {
 
 namespace {
 
+/// What an axis's components follow from its inputs (buildAxis): the lens wedge with its sign
+/// folded into u, the x bandwidth and the number of pairs the window fits.
+struct AxisFit {
+    double suLo = 0, suHi = 0, uSign = 1;
+    bool straddle = false;
+    double omegaX = 0;
+    int pairs = 1;
+};
+
+AxisFit fitAxis(const AxisInputs& in, const MaafOptions& o) {
+    AxisFit f;
+    // Lens wedge, with the sign folded into u (eq. 24 assumes 0 < s^u_min <= s^u_max).
+    f.suLo = in.suMin;
+    f.suHi = in.suMax;
+    if (in.lens && f.suHi < 0) {
+        f.suLo = -in.suMax;
+        f.suHi = -in.suMin;
+        f.uSign = -1;
+    }
+    f.straddle = in.lens && f.suLo < 0;
+    if (f.straddle) {  // the focal plane crosses the pixel's lens samples: a box in (Omega_x, Omega_u)
+        f.suHi = std::max(std::abs(f.suLo), std::abs(f.suHi));
+        f.suLo = 0;
+    }
+    // Sec. 6.2: the x bandwidth is the smallest of the pixel's and the two wedges'.
+    f.omegaX = o.pixelBandwidth / in.step;
+    f.omegaX = std::min(f.omegaX, in.omegaY / in.sMin);
+    if (in.lens && f.suLo > 0) f.omegaX = std::min(f.omegaX, in.omegaU / f.suLo);
+    f.pairs = (in.fallback || f.straddle) ? 1 : o.pairs;
+    // The window resolves Fourier widths down to about 3 / (R step): use only as many components
+    // as keep the central one's 3 sigma within R = fitShare maxRadius pixels. Its Fourier std is
+    // spatialScale Omega_x / K (maafComponents: sx = (Om / s_min) / K = Omega_x / K), so
+    // 3 K / (spatialScale Omega_x step) <= R, K <= spatialScale Omega_x R step / 3.
+    if (o.fitComponents) f.pairs = std::min(f.pairs, maafFitPairs(f.omegaX, in.step, o));
+    return f;
+}
+
+/// The components an axis uses (1 where the signal has no wedge: no occluder, no bounce hit).
+int axisPairs(const AxisInputs& in, const MaafOptions& o) { return in.yWedge ? fitAxis(in, o).pairs : 1; }
+
 MaafAxis buildAxis(const AxisInputs& in, const MaafOptions& o) {
-    const int pairs = o.pairs, maxRadius = o.maxRadius;
+    const int maxRadius = o.maxRadius;
     MaafAxis ax{};
     const float sxFloor = float(1.0 / (maxRadius * in.step));  // primal std of maxRadius pixels
     if (!in.yWedge) {
@@ -81,22 +121,10 @@ MaafAxis buildAxis(const AxisInputs& in, const MaafOptions& o) {
         ax.weight[0] = 1;
         return ax;
     }
-    // Lens wedge, with the sign folded into u (eq. 24 assumes 0 < s^u_min <= s^u_max).
-    double suLo = in.suMin, suHi = in.suMax, uSign = 1;
-    if (in.lens && suHi < 0) {
-        suLo = -in.suMax;
-        suHi = -in.suMin;
-        uSign = -1;
-    }
-    bool straddle = in.lens && suLo < 0;
-    if (straddle) {  // the focal plane crosses the pixel's lens samples: a box in (Omega_x, Omega_u)
-        suHi = std::max(std::abs(suLo), std::abs(suHi));
-        suLo = 0;
-    }
-    // Sec. 6.2: the x bandwidth is the smallest of the pixel's and the two wedges'; tighten Omega_y.
-    double omegaX = o.pixelBandwidth / in.step;
-    omegaX = std::min(omegaX, in.omegaY / in.sMin);
-    if (in.lens && suLo > 0) omegaX = std::min(omegaX, in.omegaU / suLo);
+    const AxisFit fit = fitAxis(in, o);
+    const double suLo = fit.suLo, suHi = fit.suHi, uSign = fit.uSign, omegaX = fit.omegaX;
+    const int n = fit.pairs;
+    // Omega_y tightened to s_min times the x bandwidth (Sec. 6.2).
     WedgeShape w;
     w.omegaYMax = std::min(in.omegaY, in.sMin * omegaX);
     w.sMin = in.sMin;
@@ -105,12 +133,6 @@ MaafAxis buildAxis(const AxisInputs& in, const MaafOptions& o) {
     w.suMin = suLo;
     w.suMax = suHi;
     w.omegaUMax = in.omegaU;
-    int n = (in.fallback || straddle) ? 1 : pairs;
-    // The window resolves Fourier widths down to about 3 / (R step): use only as many components
-    // as keep the central one's 3 sigma within R = fitShare maxRadius pixels. Its Fourier std is
-    // spatialScale Omega_x / K (maafComponents: sx = (Om / s_min) / K = Omega_x / K), so
-    // 3 K / (spatialScale Omega_x step) <= R, K <= spatialScale Omega_x R step / 3.
-    if (o.fitComponents) n = std::min(n, maafFitPairs(omegaX, in.step, o));
     MaafComponent comps[kMaafMaxPairs];
     maafComponents(n, w, comps);
     ax.pairs = n;
@@ -129,11 +151,15 @@ MaafAxis buildAxis(const AxisInputs& in, const MaafOptions& o) {
 
 }  // namespace
 
-MaafEffect::MaafEffect(int width, int height, Compute compute)
+MaafEffect::MaafEffect(int width, int height, Compute compute, const Image<uint8_t>* region)
     : m_width(width), m_height(height), m_compute(std::move(compute)), m_central(size_t(width) * height) {
     parallelRows(height, [&](int y) {
         for (int x = 0; x < width; ++x) {
             size_t p = size_t(y) * width + x;
+            if (region && !(*region)[p]) {
+                m_central[p] = Central{{0.f, 0.f}, {0.f, 0.f}, {1, 1}};
+                continue;
+            }
             for (int k = 0; k < 2; ++k) {
                 MaafAxis a;
                 m_compute(p, k, a);
@@ -148,8 +174,100 @@ MaafEffect::MaafEffect(int width, int height, Compute compute)
 MaafEffect::MaafEffect(const Image<MaafPixel>& params)
     : MaafEffect(params.width(), params.height(), [&params](size_t p, int k, MaafAxis& out) { out = params[p].axis[k]; }) {}
 
+namespace {
+
+/// Whether pixel p uses the central component only because of the focal plane (MaafParams::fallback).
+bool focalFallback(const FrameBuffers& fb, const WedgeField& wf, bool lens, const MaafOptions& o, size_t p) {
+    return fb.object[p] >= 0 && o.focalFallback && lens && (wf.focalStraddle[p] > 0 || (wf.suMin[p] < 0 && wf.suMax[p] > 0));
+}
+
+/// The indirect light's inputs of pixel p's axis k: the bounce wedge in the tangent plane (z
+/// clamped to zMinPixels pixel sizes); the bounce is a cosine-weighted direction. `footprint`
+/// and `fallback` are the pixel's (as the prefilter saw them); false where it has no surface.
+bool indirectInputs(const WedgeField& wf, const AxisFrame& frame, float object, float footprint, bool fallback,
+                    bool lens, size_t p, int k, const MaafOptions& o, AxisInputs& in) {
+    if (object < 0) return false;
+    in.lens = lens;
+    in.omegaU = o.lensOmega;
+    in.fallback = fallback;
+    float d = std::max(footprint, 1e-12f);
+    in.step = frame.step[k];
+    in.yWedge = wf.zMin[p] < kInf;
+    in.omegaY = o.indirectOmega;
+    in.sMin = std::max(wf.zMin[p], o.zMinPixels * d);
+    // Outer components only where the nearest bounce hit is not much closer than the clamp:
+    // a pixel that sees surfaces within a few pixel sizes (a corner, a contact) has light
+    // that varies faster than its clamped wedge says, and outer components placed by that
+    // wedge measured as bias (MaafOptions::outerMinBounce).
+    if (wf.zMin[p] < o.outerMinBounce * o.zMinPixels * d) in.fallback = true;
+    in.sMax = std::max(wf.zMax[p], float(in.sMin));
+    in.suMin = wf.suMin[p] * in.step;
+    in.suMax = wf.suMax[p] * in.step;
+    return true;
+}
+
+}  // namespace
+
+Image<uint8_t> maafIndirectOuter(const FrameBuffers& fb, const WedgeField& wf, const ViewGeometry& view, const MaafOptions& o) {
+    const int W = fb.width, H = fb.height;
+    const bool lens = view.apertureRadius > 0;
+    Image<uint8_t> outer(W, H);
+    if (o.pairs < 2) return outer;
+    parallelRows(H, [&](int y) {
+        for (int x = 0; x < W; ++x) {
+            const size_t p = size_t(y) * W + x;
+            // What needs no frame first: no surface, no bounce hit, the focal plane, a near hit.
+            if (fb.object[p] < 0 || !(wf.zMin[p] < kInf)) continue;
+            const bool fallback = focalFallback(fb, wf, lens, o, p);
+            const float d = std::max(fb.footprint[p], 1e-12f);
+            if (fallback || wf.zMin[p] < o.outerMinBounce * o.zMinPixels * d) continue;
+            // K >= 3 needs spatialScale Omega_x R step / 3 >= 3 (maafFitPairs) with Omega_x at most
+            // indirectOmega / s_min (fitAxis): a step of at least 9 s_min / (spatialScale
+            // indirectOmega R), which most pixels' steps are far from (a 0.1% margin).
+            const double sMin = std::max(wf.zMin[p], o.zMinPixels * d);
+            const double fitRadius = double(o.fitShare) * o.maxRadius;
+            if (o.fitComponents &&
+                indirectStepBound(fb, view, p) < 0.999 * 9.0 * sMin / (o.spatialScale * o.indirectOmega * fitRadius))
+                continue;
+            const AxisFrame frame = indirectFrame(fb, view, p);
+            for (int k = 0; k < 2 && !outer[p]; ++k) {
+                AxisInputs in;
+                if (indirectInputs(wf, frame, fb.object[p], fb.footprint[p], fallback, lens, p, k, o, in))
+                    outer[p] = axisPairs(in, o) > 1;
+            }
+        }
+    });
+    return outer;
+}
+
+Image<uint8_t> dilateBox(const Image<uint8_t>& mask, int radius) {
+    const int W = mask.width(), H = mask.height();
+    // Running counts over [x - radius, x + radius] along each row, then along each column.
+    Image<uint8_t> rows(W, H), out(W, H);
+    parallelRows(H, [&](int y) {
+        const uint8_t* m = &mask[size_t(y) * W];
+        int count = 0;
+        for (int x = 0; x < std::min(W, radius); ++x) count += m[x] != 0;
+        for (int x = 0; x < W; ++x) {
+            if (x + radius < W) count += m[x + radius] != 0;
+            rows[size_t(y) * W + x] = count > 0;
+            if (x - radius >= 0) count -= m[x - radius] != 0;
+        }
+    });
+    parallelRows(W, [&](int x) {  // (over columns)
+        int count = 0;
+        for (int y = 0; y < std::min(H, radius); ++y) count += rows(x, y);
+        for (int y = 0; y < H; ++y) {
+            if (y + radius < H) count += rows(x, y + radius);
+            out(x, y) = count > 0;
+            if (y - radius >= 0) count -= rows(x, y - radius);
+        }
+    });
+    return out;
+}
+
 MaafParams maafParams(const FrameBuffers& fb, const WedgeField& wf, const FilterFrames& frames, const ViewGeometry& view,
-                      const MaafOptions& o) {
+                      const MaafOptions& o, const Image<uint8_t>* region) {
     const int W = fb.width, H = fb.height;
     // The light whose spectrum weighs the outer components: the only one the filters see (below;
     // a lamp of many coplanar triangles is one, scene::lightGroups), if it is planar (a sphere's
@@ -160,10 +278,7 @@ MaafParams maafParams(const FrameBuffers& fb, const WedgeField& wf, const Filter
     parallelRows(H, [&](int y) {
         for (int x = 0; x < W; ++x) {
             size_t p = size_t(y) * W + x;
-            fallback[p] = fb.object[p] >= 0 && o.focalFallback && lens &&
-                                  (wf.focalStraddle[p] > 0 || (wf.suMin[p] < 0 && wf.suMax[p] > 0))
-                              ? 1.f
-                              : 0.f;
+            fallback[p] = focalFallback(fb, wf, lens, o, p) ? 1.f : 0.f;
         }
     });
     // The planes the components read that the renderer rewrites after adaptive sampling are
@@ -205,31 +320,19 @@ MaafParams maafParams(const FrameBuffers& fb, const WedgeField& wf, const Filter
         in.axis = axis;
         out = buildAxis(in, o);
     };
-    // Indirect: the bounce wedge in the tangent plane (z clamped to zMinPixels pixel sizes);
-    // the bounce is a cosine-weighted direction.
-    auto indirect = [&, common, snap, o](size_t p, int k, MaafAxis& out) {
+    // Indirect: the bounce wedge (indirectInputs).
+    auto indirect = [&, snap, lens, o](size_t p, int k, MaafAxis& out) {
         AxisInputs in;
-        if (!common(p, in)) {
+        if (!indirectInputs(wf, frames.indirect[p], snap->object[p], snap->footprint[p], snap->fallback[p] > 0, lens, p, k,
+                            o, in)) {
             out = MaafAxis{};
             out.pairs = 1;
             return;
         }
-        float d = std::max(snap->footprint[p], 1e-12f);
-        in.step = frames.indirect[p].step[k];
-        in.yWedge = wf.zMin[p] < kInf;
-        in.omegaY = o.indirectOmega;
-        in.sMin = std::max(wf.zMin[p], o.zMinPixels * d);
-        // Outer components only where the nearest bounce hit is not much closer than the clamp:
-        // a pixel that sees surfaces within a few pixel sizes (a corner, a contact) has light
-        // that varies faster than its clamped wedge says, and outer components placed by that
-        // wedge measured as bias (MaafOptions::outerMinBounce).
-        if (wf.zMin[p] < o.outerMinBounce * o.zMinPixels * d) in.fallback = true;
-        in.sMax = std::max(wf.zMax[p], float(in.sMin));
-        in.suMin = wf.suMin[p] * in.step;
-        in.suMax = wf.suMax[p] * in.step;
         out = buildAxis(in, o);
     };
-    return MaafParams{o.directEffect ? MaafEffect(W, H, direct) : MaafEffect(W, H), MaafEffect(W, H, indirect), std::move(fallback)};
+    return MaafParams{o.directEffect ? MaafEffect(W, H, direct) : MaafEffect(W, H), MaafEffect(W, H, indirect, region),
+                      std::move(fallback)};
 }
 
 namespace {
@@ -299,20 +402,38 @@ void MaafSample::coordinates(const ViewGeometry& view, const AxisFrame& direct, 
     u[1] = -(2.f * fromUnorm16(lens[1]) - 1.f);  // lens y is along camera up; axis 2 is image down
 }
 
-MaafAccumulator::MaafAccumulator(const MaafEffect& params, int pairs, int values)
+MaafAccumulator::MaafAccumulator(const MaafEffect& params, int pairs, int values, const Image<uint8_t>* region)
     : m_width(params.width()), m_height(params.height()), m_pairs(pairs), m_values(values),
       m_channels(values + 1) {
     const size_t n = size_t(params.width()) * params.height();
     m_bands1.resize(n);
     m_bands2.resize(n);
     m_offset.resize(n + 1);
-    size_t total = 0;
-    for (size_t p = 0; p < n; ++p) {
-        m_bands1[p] = uint8_t(2 * std::min(params.pairs(p, 0), pairs) - 1);
-        m_bands2[p] = uint8_t(2 * std::min(params.pairs(p, 1), pairs) - 1);
-        m_offset[p] = total;
-        total += size_t(m_bands1[p]) * m_bands2[p] * size_t(m_channels);
-    }
+    // Each row's bands and offsets from its own start, the rows' starts, then the offsets (in
+    // parallel: one pass over a 512x512 image's pixels on one thread took 0.01-0.02 s).
+    const int W = m_width, H = m_height;
+    std::vector<size_t> rowStart(size_t(H) + 1, 0);
+    parallelRows(H, [&](int y) {
+        size_t total = 0;
+        for (int x = 0; x < W; ++x) {
+            const size_t p = size_t(y) * W + x;
+            if (region && !(*region)[p]) {  // no storage
+                m_bands1[p] = m_bands2[p] = 0;
+                m_offset[p] = total;
+                continue;
+            }
+            m_bands1[p] = uint8_t(2 * std::min(params.pairs(p, 0), pairs) - 1);
+            m_bands2[p] = uint8_t(2 * std::min(params.pairs(p, 1), pairs) - 1);
+            m_offset[p] = total;
+            total += size_t(m_bands1[p]) * m_bands2[p] * size_t(m_channels);
+        }
+        rowStart[size_t(y) + 1] = total;
+    });
+    for (int y = 0; y < H; ++y) rowStart[size_t(y) + 1] += rowStart[size_t(y)];
+    parallelRows(H, [&](int y) {
+        for (int x = 0; x < W; ++x) m_offset[size_t(y) * W + x] += rowStart[size_t(y)];
+    });
+    const size_t total = rowStart[size_t(H)];
     m_offset[n] = total;
     m_data.resize(total);
     parallelRows(m_height, [&](int y) {
@@ -446,9 +567,14 @@ Image3f MaafAccumulator::filter(const MaafEffect& params, const FrameBuffers& fb
     // as the most any pixel within the widest window has (1 in most of an image), plus the
     // central-only band. A fixed (2N-1) + 1 bands per pixel would be 38 MB at 512x512, mostly zeros.
     const int reach = std::min(o.maxRadius, kMaafMaxWindowRadius);
+    // Where pass 1 does not run (outside `needed`), no bands and no storage.
     LargeVector<uint8_t> interBands(size_t(W) * H);
     parallelRows(H, [&](int y) {
         for (int x = 0; x < W; ++x) {
+            if (only && !needed[size_t(y) * W + x]) {
+                interBands[size_t(y) * W + x] = 0;
+                continue;
+            }
             uint8_t b = 1;
             for (int xx = std::max(0, x - reach); xx <= std::min(W - 1, x + reach); ++xx)
                 b = std::max(b, m_bands2[size_t(y) * W + xx]);
@@ -457,7 +583,8 @@ Image3f MaafAccumulator::filter(const MaafEffect& params, const FrameBuffers& fb
     });
     LargeVector<size_t> interOffset(size_t(W) * H + 1);
     interOffset[0] = 0;
-    for (size_t p = 0; p < size_t(W) * H; ++p) interOffset[p + 1] = interOffset[p] + size_t(interBands[p] + 1) * C;
+    for (size_t p = 0; p < size_t(W) * H; ++p)
+        interOffset[p + 1] = interOffset[p] + (interBands[p] > 0 ? size_t(interBands[p] + 1) * C : 0);
     LargeVector<float> inter(interOffset.back());  // default-initialised: zeroed by the rows in parallel
     parallelRows(H, [&](int y) {
         std::fill(inter.begin() + interOffset[size_t(y) * W], inter.begin() + interOffset[size_t(y + 1) * W], 0.f);

@@ -170,7 +170,9 @@ class MaafEffect {
 public:
     /// Writes pixel p's components along axis k.
     using Compute = std::function<void(size_t p, int k, MaafAxis& out)>;
-    MaafEffect(int width, int height, Compute compute);
+    /// With `region`, the stored widths only where it is non-zero; elsewhere pairs() is 1 and
+    /// centralSx() 0 (a caller that reads only the region, and has no outer components outside it).
+    MaafEffect(int width, int height, Compute compute, const Image<uint8_t>* region = nullptr);
     /// Central-only everywhere, with no widths: an effect MAAF does not filter (AAF's pipeline
     /// filters it with AAF's filter). Stores nothing; pairs() is 1 and axis() the bare centre.
     MaafEffect(int width, int height) : m_width(width), m_height(height) {}
@@ -216,9 +218,19 @@ struct MaafParams {
 };
 
 /// Components for every pixel, effect and axis. The result refers to fb, wedges, frames and
-/// view, which must outlive it.
+/// view, which must outlive it. With `region`, the indirect effect's stored widths only there
+/// (MaafEffect), whose frames are then all `frames.indirect` needs.
 MaafParams maafParams(const FrameBuffers& fb, const WedgeField& wedges, const FilterFrames& frames,
-                      const ViewGeometry& view, const MaafOptions& options);
+                      const ViewGeometry& view, const MaafOptions& options, const Image<uint8_t>* region = nullptr);
+
+/// 1 where maafParams' indirect effect has outer components on either axis (pairs() > 1),
+/// decided from the pixel's wedge and its frame's steps alone, without the components, the
+/// frames image or the effect: where MAAF's sparse pipeline computes them (render/method_maaf.cpp).
+Image<uint8_t> maafIndirectOuter(const FrameBuffers& fb, const WedgeField& wedges, const ViewGeometry& view,
+                                 const MaafOptions& options);
+
+/// 1 within `radius` pixels along both image axes (a (2 radius + 1)^2 box) of a non-zero pixel of `mask`.
+Image<uint8_t> dilateBox(const Image<uint8_t>& mask, int radius);
 
 /// Per-pixel accumulations of eq. 23 for one effect, (2N-1)^2 bands x (values..., weight).
 /// Indirect light accumulates rgb with weight 1; direct light accumulates the visibility with
@@ -227,7 +239,9 @@ MaafParams maafParams(const FrameBuffers& fb, const WedgeField& wedges, const Fi
 /// own components use ((2 N_1 - 1) x (2 N_2 - 1)), so memory and work follow the wedge.
 class MaafAccumulator {
 public:
-    MaafAccumulator(const MaafEffect& params, int pairs, int values);
+    /// With `region`, storage only for the pixels where it is non-zero (the others have no bands
+    /// and must not be read: a filter whose `only` pixels' windows lie within the region).
+    MaafAccumulator(const MaafEffect& params, int pairs, int values, const Image<uint8_t>* region = nullptr);
     /// Upper bound of the memory for every pixel using all components (for the memory check).
     static size_t bytes(int width, int height, int pairs, int values) {
         return size_t(width) * height * size_t(sqr(2 * pairs - 1)) * size_t(values + 1) * sizeof(float);

@@ -1,9 +1,10 @@
 // --method maaf: multiple axis-aligned filters (filter/maaf.h) as in Sec. 6.2 of the paper.
 // Stages: initial sampling (16 path samples per pixel with occluder spans, folded into the
 // pixel statistics); prefilter: AAF's slopes (with --maaf-paper-rates MAAF's, over a 5x5
-// window), components per pixel and AAF's rates; adaptive sampling at AAF's rates in every pixel
-// (with --maaf-paper-rates only where the wedge degenerates at the focal plane, Sec. 6.2), and
-// the emitter and mixed-pixel top-ups; the initial samples of the pixels with outer components
+// window), the pixels whose indirect filter has outer components, the components (by default
+// only within the filter's window of those pixels) and AAF's rates; adaptive sampling at AAF's
+// rates in every pixel (with --maaf-paper-rates only where the wedge degenerates at the focal
+// plane, Sec. 6.2), and the emitter and mixed-pixel top-ups; the initial samples of the pixels with outer components
 // traced again (their adaptive samples are kept when taken); then the accumulation of eq. 23
 // over each pixel's samples (the plain sums of the statistics where the pixel uses the central
 // component only); filter: AAF's, then eq. 21 on both image axes where the effect has outer
@@ -184,8 +185,26 @@ void renderMaaf(const MethodContext& ctx, RenderResult& result) {
     // slopes, its central filter everywhere and adaptive samples only at the focal plane (Sec. 6.2).
     const bool paper = ctx.options.maafPaperRates;
     const filter::WedgeField wedges = filter::prefilterWedges(fb, paper ? wo : filter::aafWedgeOptions());
-    filter::FilterFrames frames = filter::computeFrames(fb, view, mo.directEffect);  // (the direct light's only if MAAF filters it)
-    filter::MaafParams params = filter::maafParams(fb, wedges, frames, view, mo);
+    // Sparse (the default in AAF's pipeline): only the indirect light can have outer components,
+    // and MAAF's filter reads the indirect light's frames, components and accumulations only
+    // within its window (maxRadius) of the pixels that have them, so those are decided first
+    // (filter::maafIndirectOuter: from the wedge and the frame's steps) and the rest is computed
+    // only in that region. Without any such pixel the render is AAF's.
+    const bool sparse = ctx.options.maafSparse && !paper && !mo.directEffect && !mo.apertureWindows && ctx.options.aovDir.empty();
+    Image<uint8_t> outerMask, region;
+    size_t outerCount = 0;
+    if (sparse) {
+        outerMask = filter::maafIndirectOuter(fb, wedges, view, mo);
+        for (size_t i = 0; i < pixels; ++i) outerCount += outerMask[i];
+        region = filter::dilateBox(outerMask, mo.maxRadius);
+    }
+    const Image<uint8_t>* where = sparse ? &region : nullptr;
+    filter::FilterFrames frames;
+    if (!sparse || outerCount > 0)
+        frames = filter::computeFrames(fb, view, mo.directEffect, where);  // (the direct light's only if MAAF filters it)
+    filter::MaafParams params = !sparse || outerCount > 0
+                                    ? filter::maafParams(fb, wedges, frames, view, mo, where)
+                                    : filter::MaafParams{filter::MaafEffect(W, H), filter::MaafEffect(W, H), Image1f()};
     const filter::AafOptions ao;
     const filter::AafParams rates = filter::aafParams(fb, wedges, view, ao);
     Image<uint32_t> extra(W, H);
@@ -212,7 +231,8 @@ void renderMaaf(const MethodContext& ctx, RenderResult& result) {
 
     // Pixels whose accumulation has outer components (or windows) need their samples one by
     // one; the others use the pixel statistics' plain sums (below).
-    auto outer = [&](size_t p) {
+    auto outer = [&](size_t p) -> bool {
+        if (sparse) return outerMask[p];
         return mo.apertureWindows || outerComponents(params.direct, p) || outerComponents(params.indirect, p);
     };
 
@@ -285,8 +305,12 @@ void renderMaaf(const MethodContext& ctx, RenderResult& result) {
     t.reset();
     // An effect without outer components anywhere is AAF's alone (by default; below).
     std::optional<filter::MaafAccumulator> accDirect, accIndirect;
-    if (paper || anyOuter(params.direct)) accDirect.emplace(params.direct, mo.pairs, 1);
-    if (paper || anyOuter(params.indirect)) accIndirect.emplace(params.indirect, mo.pairs, 3);
+    if (sparse) {
+        if (outerCount > 0) accIndirect.emplace(params.indirect, mo.pairs, 3, &region);
+    } else {
+        if (paper || anyOuter(params.direct)) accDirect.emplace(params.direct, mo.pairs, 1);
+        if (paper || anyOuter(params.indirect)) accIndirect.emplace(params.indirect, mo.pairs, 3);
+    }
     result.extra.emplace_back("maaf_accumulator_bytes", double((accDirect ? accDirect->allocatedBytes() : 0) +
                                                                (accIndirect ? accIndirect->allocatedBytes() : 0)));
     std::atomic<uint64_t> outerPixels{0};  // pixels whose accumulation has outer components
@@ -294,6 +318,7 @@ void renderMaaf(const MethodContext& ctx, RenderResult& result) {
         uint64_t outerInRow = 0;
         for (int x = 0; x < W; ++x) {
             size_t p = size_t(y) * W + x;
+            if (sparse && !region[p]) continue;  // no storage: the filter does not read it
             const int primary = stats[p].primary();
             // Central component only on both axes (most pixels: the window fit): eq. 23 is the
             // primary surface's plain sums, which the pixel statistics already hold.
@@ -360,6 +385,7 @@ void renderMaaf(const MethodContext& ctx, RenderResult& result) {
         auto maafWhereOuter = [&](const std::optional<filter::MaafAccumulator>& acc, const filter::MaafEffect& effect,
                                   const Image<filter::AxisFrame>& axes, Image3f aaf) {
             if (!acc) return aaf;
+            if (sparse) return acc->filter(effect, fb, axes, aaf, mo, &outerMask);
             Image<uint8_t> where(W, H);
             for (size_t i = 0; i < pixels; ++i) where[i] = outerComponents(effect, i);
             return acc->filter(effect, fb, axes, aaf, mo, &where);

@@ -40,6 +40,10 @@ struct RenderOptions {
     // Keep a record of every pixel's initial samples instead of tracing again the initial
     // samples of the pixels with outer components (render/method_maaf.cpp: same image, more memory).
     bool maafKeepRecords = false;
+    // In AAF's pipeline, the indirect light's frames, components and accumulations only within
+    // the filter's window of the pixels with outer components (render/method_maaf.cpp: the same
+    // image); false computes them in every pixel (--maaf-dense, for checks).
+    bool maafSparse = true;
     std::string maafWeights = "sampling";  // mu_p: sampling | eq10 | unit (filter/maaf.h, "Weights")
     // à-trous
     int atrousIterations = 5;
