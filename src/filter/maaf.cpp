@@ -409,8 +409,9 @@ MaafAccumulator::MaafAccumulator(const MaafEffect& params, int pairs, int values
     m_bands1.resize(n);
     m_bands2.resize(n);
     m_offset.resize(n + 1);
-    // Each row's bands and offsets from its own start, the rows' starts, then the offsets (in
-    // parallel: one pass over a 512x512 image's pixels on one thread took 0.01-0.02 s).
+    // Each row's bands and offsets from its own start, the rows' starts, then the offsets, in
+    // parallel (the serial pass was part of the 0.006-0.028 s the layout took at 512x512,
+    // docs/maaf.md, "Sparse components").
     const int W = m_width, H = m_height;
     std::vector<size_t> rowStart(size_t(H) + 1, 0);
     parallelRows(H, [&](int y) {

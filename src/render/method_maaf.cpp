@@ -189,7 +189,9 @@ void renderMaaf(const MethodContext& ctx, RenderResult& result) {
     // and MAAF's filter reads the indirect light's frames, components and accumulations only
     // within its window (maxRadius) of the pixels that have them, so those are decided first
     // (filter::maafIndirectOuter: from the wedge and the frame's steps) and the rest is computed
-    // only in that region. Without any such pixel the render is AAF's.
+    // only in that region. Without any such pixel the render is AAF's. MAAF's prefilter time
+    // over AAF's at 512x512, medians of 12 rounds: cornell 0.23 -> 0.07 s, conference 0.14 ->
+    // 0.08 s, the same image bytes (docs/maaf.md, "Sparse components"; --maaf-dense: before).
     const bool sparse = ctx.options.maafSparse && !paper && !mo.directEffect && !mo.apertureWindows && ctx.options.aovDir.empty();
     Image<uint8_t> outerMask, region;
     size_t outerCount = 0;
