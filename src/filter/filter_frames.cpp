@@ -59,8 +59,9 @@ float indirectStepBound(const FrameBuffers& fb, const ViewGeometry& view, size_t
     const Vec3f n = fb.normal[p];
     const float depth = fb.depth[p];
     if (fb.object[p] < 0 || depth <= 0) return 1.f;
-    // |s_k| = scale |e - D (n . e) / (n . D)| <= scale (1 + |D| |n| / |n . D|) for a unit e,
-    // with n . D capped as tangentSteps caps it; a 1% margin for the rounding of either.
+    // |s_k| = scale |e - D (n . e) / (n . D)| <= scale (1 + |D| |n| / |n . D|) for a unit e
+    // (the camera's right and down), with n . D capped as tangentSteps caps it; a 1% margin for
+    // the rounding of either.
     const Vec3f D = (fb.position[p] - view.cameraPosition) / depth;
     const float lenD = length(D);
     const float nD = std::max(std::abs(dot(n, D)), 0.1f * lenD);
