@@ -154,15 +154,18 @@ struct Layer {
     }
     bool sharp = true;
     bool sharpRun = false;  // several still layers, each sharp, merged into one (splitLayers)
-    float sigma = 0;
+    // The Gaussians of the sharp image (layers.h, step 2): sigma for the radiance and the motion,
+    // sigmaCoverage (<= sigma) for N, D and the slope, whose grid blur the rays' shear is shaped for.
+    float sigma = 0, sigmaCoverage = 0;
     int timeBins = 1;
     // The grid: cell (i, j) covers the pixel [gx0 + i, gx0 + i + 1) x [gy0 + j, gy0 + j + 1).
     // (Half-pixel cells blur less but are noisier: AAF relMSE on conference at 512x512 0.000625
     // -> 0.000842.)
     int gx0 = 0, gy0 = 0, gw = 0, gh = 0;
-    // Per cell: N, then per time bin W, R, G, B (accumulated), or alpha, then per time bin
-    // R, G, B (resolved); last, the layer's own slope there (a slanted surface's changes across
-    // the tile, which the rays follow). D has a grid of its own (accD): every sample behind the
+    // Per cell: N, the sum of the samples' slopes, then per time bin W, R, G, B (accumulated;
+    // the coverage's channels first, so that each Gaussian smooths a contiguous run), or alpha,
+    // then per time bin R, G, B, and last the layer's own slope there (resolved: a slanted
+    // surface's slope changes across the tile, and the rays follow it). D has a grid of its own (accD): every sample behind the
     // layer adds to it, at scattered cells, and a 4-byte cell keeps those writes in cache (a
     // moving layer's accumulated cell is 136 bytes).
     std::vector<float> acc, accD, cell;
@@ -172,7 +175,7 @@ struct Layer {
     /// How far (pixels) a ray's lookups can land from the pixel: the largest slope (the rays
     /// follow the slope they find, never beyond the layer's extremes) and half the motion.
     float rayReach = 0;
-    int accStride() const { return 2 + 4 * timeBins; }   // ... and last the sum of the samples' slopes
+    int accStride() const { return 2 + 4 * timeBins; }
     int cellStride() const { return 2 + 3 * timeBins; }  // ... and last the samples' mean slope there
 
     Vec2f sharpPosition(const Gathered& s) const { return sharp ? Vec2f{s.x, s.y} : sharpPosition(s, mx, my); }
@@ -405,27 +408,43 @@ void splitLayers(const std::vector<Gathered>& g, const SlopeRange (&range)[2], c
     }
 }
 
-/// Separable Gaussian of `sigma` cells over the `stride` interleaved channels of `acc` (gw x gh).
-void smooth(std::vector<float>& acc, int gw, int gh, int stride, float sigma) {
+/// Separable Gaussian of `sigma` cells over channels [c0, c1) of the `stride` interleaved
+/// channels of `acc` (gw x gh); c1 < 0: to the last.
+void smooth(std::vector<float>& acc, int gw, int gh, int stride, float sigma, int c0 = 0, int c1 = -1) {
+    if (c1 < 0) c1 = stride;
+    const int n = c1 - c0;
     const int r = int(std::ceil(3.f * sigma));
     std::vector<float> w(2 * r + 1);
     for (int k = -r; k <= r; ++k) w[k + r] = std::exp(-0.5f * float(k * k) / (sigma * sigma));
-    std::vector<float> tmp(acc.size(), 0.f);
+    const size_t cells = size_t(gw) * gh;
+    std::vector<float> tmp(cells * n, 0.f);
     for (int j = 0; j < gh; ++j)
         for (int i = 0; i < gw; ++i) {
-            float* out = &tmp[(size_t(j) * gw + i) * stride];
+            float* out = &tmp[(size_t(j) * gw + i) * n];
             for (int k = std::max(-r, -i); k <= std::min(r, gw - 1 - i); ++k) {
-                const float* in = &acc[(size_t(j) * gw + i + k) * stride];
-                for (int ch = 0; ch < stride; ++ch) out[ch] += w[k + r] * in[ch];
+                const float* in = &acc[(size_t(j) * gw + i + k) * stride + c0];
+                for (int ch = 0; ch < n; ++ch) out[ch] += w[k + r] * in[ch];
             }
         }
-    std::fill(acc.begin(), acc.end(), 0.f);
+    if (n == stride) {
+        std::fill(acc.begin(), acc.end(), 0.f);
+        for (int j = 0; j < gh; ++j)
+            for (int k = std::max(-r, -j); k <= std::min(r, gh - 1 - j); ++k) {
+                const float wk = w[k + r];
+                const float* in = &tmp[size_t(j + k) * gw * stride];
+                float* out = &acc[size_t(j) * gw * stride];
+                for (int i = 0; i < gw * stride; ++i) out[i] += wk * in[i];
+            }
+        return;
+    }
+    for (size_t q = 0; q < cells; ++q) std::fill_n(&acc[q * stride + c0], n, 0.f);
     for (int j = 0; j < gh; ++j)
         for (int k = std::max(-r, -j); k <= std::min(r, gh - 1 - j); ++k) {
             const float wk = w[k + r];
-            const float* in = &tmp[size_t(j + k) * gw * stride];
-            float* out = &acc[size_t(j) * gw * stride];
-            for (int i = 0; i < gw * stride; ++i) out[i] += wk * in[i];
+            const float* in = &tmp[size_t(j + k) * gw * n];
+            float* out = &acc[size_t(j) * gw * stride + c0];
+            for (int i = 0; i < gw; ++i)
+                for (int ch = 0; ch < n; ++ch) out[size_t(i) * stride + ch] += wk * in[size_t(i) * n + ch];
         }
 }
 
@@ -442,14 +461,14 @@ void resolveCells(Layer& l, float minWeight) {
         const float* a = &l.acc[size_t(i) * as];
         const float d = l.accD[i];
         float* c = &l.cell[size_t(i) * cs];
-        c[cs - 1] = a[0] >= minWeight ? a[as - 1] / a[0] : l.c;
+        c[cs - 1] = a[0] >= minWeight ? a[1] / a[0] : l.c;
         if (d >= minWeight) {
             c[0] = std::clamp(a[0] / d, 0.f, 1.f);
             alphaOk[i] = 1;
         }
         int have = -1;
         for (int b = 0; b < bins; ++b) {
-            const float* ab = a + 1 + 4 * b;
+            const float* ab = a + 2 + 4 * b;
             if (ab[0] < minWeight) continue;
             const float inv = 1.f / ab[0];
             for (int ch = 0; ch < 3; ++ch) c[1 + 3 * b + ch] = ab[1 + ch] * inv;
@@ -459,10 +478,10 @@ void resolveCells(Layer& l, float minWeight) {
         radianceOk[i] = 1;
         // Empty time bins take the nearest bin that has samples.
         for (int b = 0; b < bins; ++b) {
-            if (a[1 + 4 * b] >= minWeight) continue;
+            if (a[2 + 4 * b] >= minWeight) continue;
             int best = have;
             for (int k = 0; k < bins; ++k)
-                if (a[1 + 4 * k] >= minWeight && std::abs(k - b) < std::abs(best - b)) best = k;
+                if (a[2 + 4 * k] >= minWeight && std::abs(k - b) < std::abs(best - b)) best = k;
             for (int ch = 0; ch < 3; ++ch) c[1 + 3 * b + ch] = c[1 + 3 * best + ch];
         }
     }
@@ -825,7 +844,16 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                         // spread, as it was, over-blurred the layers a tile's budget had widened: AAF
                         // relMSE on docs/conference-wide.json with a budget of 8 layers 0.000927 -> 0.000667.)
                         l.sigma = std::clamp(o.sigmaScale * std::abs(l.c), o.sigmaMin, o.sigmaMax);
-                        const float gridBlur = kCellBlur + sqr(l.sigma);
+                        // The coverage's Gaussian may be narrower than the radiance's: a Gaussian
+                        // of 0.5 px sampled at 1-px cells is aliased, and the edge it gives a
+                        // layer just past the sharp threshold depends on where the edge falls
+                        // in its cell (a half-plane at c = 1.49 px: 0.068 of the edge's
+                        // contrast too sharp on a cell boundary, 0.010 on a cell centre;
+                        // scripts/layer_edge_sim.py). With a narrower one the rays' lens shear,
+                        // continuous, carries more of the blur (docs/layers.md, "What the mixed
+                        // pixels' error is made of").
+                        l.sigmaCoverage = std::clamp(o.sigmaScale * std::abs(l.c), std::min(o.sigmaCoverageMin, o.sigmaMin), l.sigma);
+                        const float gridBlur = kCellBlur + sqr(l.sigmaCoverage);
                         l.gridBlur = gridBlur;
                         if (l.followsSlope()) l.buildShearTable();
                         if (0.25f * sqr(l.c) >= gridBlur) {
@@ -882,13 +910,13 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                     if (ci < 0) continue;
                     l.acc[size_t(ci) * l.accStride()] += 1.f;
                     l.accD[ci] += 1.f;
-                    l.acc[size_t(ci + 1) * l.accStride() - 1] += s.c;
+                    l.acc[size_t(ci) * l.accStride() + 1] += s.c;
                     if (!motionAcc[size_t(sl)].empty()) {
                         float* m = &motionAcc[size_t(sl)][size_t(ci) * 3];
                         m[0] += 1.f, m[1] += s.mx, m[2] += s.my;
                     }
                     const Vec3f radiance = radianceOf(s, l);
-                    float* a = &l.acc[size_t(ci) * l.accStride() + 1 + 4 * l.timeBin(s.t)];
+                    float* a = &l.acc[size_t(ci) * l.accStride() + 2 + 4 * l.timeBin(s.t)];
                     a[0] += 1.f;
                     a[1] += radiance.x;
                     a[2] += radiance.y;
@@ -924,8 +952,13 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                 }
                 for (Layer& l : layers) {
                     if (!l.sharp) {
-                        smooth(l.acc, l.gw, l.gh, l.accStride(), l.sigma);
-                        smooth(l.accD, l.gw, l.gh, 1, l.sigma);
+                        if (l.sigmaCoverage == l.sigma) {
+                            smooth(l.acc, l.gw, l.gh, l.accStride(), l.sigma);
+                        } else {
+                            smooth(l.acc, l.gw, l.gh, l.accStride(), l.sigmaCoverage, 0, 2);  // N, the slopes
+                            smooth(l.acc, l.gw, l.gh, l.accStride(), l.sigma, 2);           // W, R, G, B
+                        }
+                        smooth(l.accD, l.gw, l.gh, 1, l.sigmaCoverage);
                     }
                     resolveCells(l, l.sharp ? 0.5f : 0.05f);
                     l.acc = std::vector<float>();
