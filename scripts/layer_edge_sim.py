@@ -4,15 +4,16 @@
 Simulates, in one dimension, what src/filter/layers.cpp does to the edge of a lit half-plane
 (pinhole image x < E) of defocus slope c over a background: samples uniform over the pixels and
 the lens disc, each splatted at its sharp position x + c u into 1-pixel cells (N: the samples on
-the half-plane; D: all of them), both smoothed by the layer's Gaussian (sigma = clamp(0.15 c,
-0.5, 2), the same unnormalised taps as smooth()), alpha = N / D per cell, then read by rays
+the half-plane; D: all of them), both smoothed by the coverage's Gaussian (sigma = clamp(0.15 c,
+floor, 2), the same unnormalised taps as smooth(); the floor 0.5 px before 2026-11-27, the
+radiance's, and 0.25 px since: LayerOptions::sigmaCoverageMin), alpha = N / D per cell, then read by rays
 jittered over the pixel, sheared by the shaped disc (kDiscShape at rho = sqrt(grid blur) / c,
 the same table and lerp as layers.cpp) and looked up bilinearly between cell centres. Against it
 the thin lens's truth: the share of a pixel's (position, lens point) pairs that see the plane.
 A layer below the grid's own blur (|c| < 2 sqrt(kCellBlur + 0.25), 1.41 px) is sharp: each pixel
 its own samples, which is exact (no sharing) at any slope.
 
-It prints, per slope, the mean over 8 edge positions (E = 48 + k / 8) of the squared coverage
+It prints, per floor and slope, the mean over 8 edge positions (E = 48 + k / 8) of the squared coverage
 error summed over the pixels of the edge, and the worst pixel at an edge on a cell boundary
 (E = 48) and at a cell centre (E = 48.5). docs/layers.md, "What the mixed pixels' error is made
 of", has the numbers and what they mean.
@@ -56,9 +57,9 @@ def smooth(a, sigma):
     return np.convolve(a, k, "same")
 
 
-def profiles(c, edge, samples=1_000_000, rays=60_000):
+def profiles(c, edge, floor, samples=1_000_000, rays=60_000):
     """The layer's and the truth's coverage of PIXELS, and whether the layer is sharp."""
-    sigma = min(max(0.5, 0.15 * c), 2.0)
+    sigma = min(max(floor, 0.15 * c), 2.0)
     grid_blur = CELL_BLUR + sigma ** 2
     ray_a, ray_b = shaped(np.sqrt(grid_blur) / c) if 0.25 * c * c >= grid_blur else (0.0, 0.0)
     sharp = 0.25 * c * c < CELL_BLUR + 0.25
@@ -89,16 +90,16 @@ def profiles(c, edge, samples=1_000_000, rays=60_000):
 
 
 def main():
-    print("slope c  sharp  mean squared error (8 positions)  worst |error| at E = 48, 48.5")
-    for c in (1.2, 1.45, 1.49, 1.6, 1.7, 2.0, 2.5, 3.5, 5.0):
+    print("floor  slope c  sharp  mean squared error (8 positions)  worst |error| at E = 48, 48.5")
+    for floor, c in [(f, c) for f in (0.5, 0.25) for c in (1.2, 1.45, 1.49, 1.6, 1.7, 2.0, 2.5, 3.5, 5.0)]:
         total, worst = 0.0, []
         for k in range(8):
-            layer, truth, sharp = profiles(c, 48 + k / 8)
+            layer, truth, sharp = profiles(c, 48 + k / 8, floor)
             err = layer - truth
             total += (err ** 2).sum() / 8
             if k in (0, 4):
                 worst.append(np.abs(err).max())
-        print(f"{c:7.2f}  {int(sharp):5d}  {total:32.5f}  {worst[0]:.3f}, {worst[1]:.3f}")
+        print(f"{floor:5.2f}  {c:7.2f}  {int(sharp):5d}  {total:32.5f}  {worst[0]:.3f}, {worst[1]:.3f}")
 
 
 if __name__ == "__main__":
