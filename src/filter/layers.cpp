@@ -165,9 +165,9 @@ struct Layer {
     // Per cell: N, the sum of the samples' slopes, then per time bin W, R, G, B (accumulated;
     // the coverage's channels first, so that each Gaussian smooths a contiguous run), or alpha,
     // then per time bin R, G, B, and last the layer's own slope there (resolved: a slanted
-    // surface's slope changes across the tile, and the rays follow it). D has a grid of its own (accD): every sample behind the
-    // layer adds to it, at scattered cells, and a 4-byte cell keeps those writes in cache (a
-    // moving layer's accumulated cell is 136 bytes).
+    // surface's slope changes across the tile, and the rays follow it). D has a grid of its own
+    // (accD): every sample behind the layer adds to it, at scattered cells, and a 4-byte cell
+    // keeps those writes in cache (a moving layer's accumulated cell is 136 bytes).
     std::vector<float> acc, accD, cell;
     /// Summed-area table of the cells with alpha > 0 ((gw + 1) x (gh + 1)): a pixel whose rays
     /// can reach only uncovered cells skips the layer (exactly: it would add nothing there).
@@ -426,17 +426,6 @@ void smooth(std::vector<float>& acc, int gw, int gh, int stride, float sigma, in
                 for (int ch = 0; ch < n; ++ch) out[ch] += w[k + r] * in[ch];
             }
         }
-    if (n == stride) {
-        std::fill(acc.begin(), acc.end(), 0.f);
-        for (int j = 0; j < gh; ++j)
-            for (int k = std::max(-r, -j); k <= std::min(r, gh - 1 - j); ++k) {
-                const float wk = w[k + r];
-                const float* in = &tmp[size_t(j + k) * gw * stride];
-                float* out = &acc[size_t(j) * gw * stride];
-                for (int i = 0; i < gw * stride; ++i) out[i] += wk * in[i];
-            }
-        return;
-    }
     for (size_t q = 0; q < cells; ++q) std::fill_n(&acc[q * stride + c0], n, 0.f);
     for (int j = 0; j < gh; ++j)
         for (int k = std::max(-r, -j); k <= std::min(r, gh - 1 - j); ++k) {
@@ -847,7 +836,7 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                         // The coverage's Gaussian may be narrower than the radiance's: a Gaussian
                         // of 0.5 px sampled at 1-px cells is aliased, and the edge it gives a
                         // layer just past the sharp threshold depends on where the edge falls
-                        // in its cell (a half-plane at c = 1.49 px: 0.068 of the edge's
+                        // in its cell (a half-plane at c = 1.49 px: 0.067 of the edge's
                         // contrast too sharp on a cell boundary, 0.010 on a cell centre;
                         // scripts/layer_edge_sim.py). With a narrower one the rays' lens shear,
                         // continuous, carries more of the blur (docs/layers.md, "What the mixed

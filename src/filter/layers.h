@@ -74,8 +74,8 @@ struct LayerOptions {
     float sigmaMin = 0.5f, sigmaMax = 2.f;
     // ... and the coverage's (N, D) and the slopes': sigmaScale |c_l| clamped to [sigmaCoverageMin,
     // the radiance's]. The rays' shear is shaped for it; the sharp threshold stays sigmaMin's.
-    // (0.5, as the radiance's, measured MC relMSE 4-9% higher on conference, cornell and
-    // cornell-sphere at 512x512; docs/layers.md, "What the mixed pixels' error is made of".)
+    // (0.5, as the radiance's, measured MC relMSE higher at 512x512 on conference by 9%, cornell
+    // by 5%, cornell-sphere by 4%; docs/layers.md, "What the mixed pixels' error is made of".)
     float sigmaCoverageMin = 0.25f;
     float splitMin = 0.5f, splitScale = 0.15f;  // a layer's slopes spread at most max(splitMin, splitScale |c|)
     // At most this many layers a tile: past it the split's thresholds widen (x 1.5 until they
