@@ -181,6 +181,14 @@ bool focalFallback(const FrameBuffers& fb, const WedgeField& wf, bool lens, cons
     return fb.object[p] >= 0 && o.focalFallback && lens && (wf.focalStraddle[p] > 0 || (wf.suMin[p] < 0 && wf.suMax[p] > 0));
 }
 
+/// Whether pixel p (footprint d) has no indirect outer components for its nearest bounce hit:
+/// a pixel that sees surfaces within a few pixel sizes (a corner, a contact) has light that
+/// varies faster than its clamped wedge says, and outer components placed by that wedge
+/// measured as bias (MaafOptions::outerMinBounce).
+bool nearBounce(const WedgeField& wf, const MaafOptions& o, size_t p, float d) {
+    return wf.zMin[p] < o.outerMinBounce * o.zMinPixels * d;
+}
+
 /// The indirect light's inputs of pixel p's axis k: the bounce wedge in the tangent plane (z
 /// clamped to zMinPixels pixel sizes); the bounce is a cosine-weighted direction. `footprint`
 /// and `fallback` are the pixel's (as the prefilter saw them); false where it has no surface.
@@ -195,11 +203,7 @@ bool indirectInputs(const WedgeField& wf, const AxisFrame& frame, float object, 
     in.yWedge = wf.zMin[p] < kInf;
     in.omegaY = o.indirectOmega;
     in.sMin = std::max(wf.zMin[p], o.zMinPixels * d);
-    // Outer components only where the nearest bounce hit is not much closer than the clamp:
-    // a pixel that sees surfaces within a few pixel sizes (a corner, a contact) has light
-    // that varies faster than its clamped wedge says, and outer components placed by that
-    // wedge measured as bias (MaafOptions::outerMinBounce).
-    if (wf.zMin[p] < o.outerMinBounce * o.zMinPixels * d) in.fallback = true;
+    if (nearBounce(wf, o, p, d)) in.fallback = true;
     in.sMax = std::max(wf.zMax[p], float(in.sMin));
     in.suMin = wf.suMin[p] * in.step;
     in.suMax = wf.suMax[p] * in.step;
@@ -220,7 +224,7 @@ Image<uint8_t> maafIndirectOuter(const FrameBuffers& fb, const WedgeField& wf, c
             if (fb.object[p] < 0 || !(wf.zMin[p] < kInf)) continue;
             const bool fallback = focalFallback(fb, wf, lens, o, p);
             const float d = std::max(fb.footprint[p], 1e-12f);
-            if (fallback || wf.zMin[p] < o.outerMinBounce * o.zMinPixels * d) continue;
+            if (fallback || nearBounce(wf, o, p, d)) continue;
             // K >= 3 needs spatialScale Omega_x R step / 3 >= 3 (maafFitPairs) with Omega_x at most
             // indirectOmega / s_min (fitAxis): a step of at least 9 s_min / (spatialScale
             // indirectOmega R), which most pixels' steps are far from (a 0.1% margin).
