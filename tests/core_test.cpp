@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 #include <zlib.h>
 
+#include <array>
 #include <atomic>
 #include <cerrno>
 #include <climits>
@@ -10,6 +11,9 @@
 #include <cmath>
 #include <filesystem>
 #include <limits>
+#include <mutex>
+#include <set>
+#include <vector>
 
 #include "core/cancel.h"
 #include "core/error.h"
@@ -431,4 +435,37 @@ TEST(ImageIo, JpegTexturesDecodeFromSrgbToLinear) {
     EXPECT_NE(jpegError(dir + "/huge.jpg").find("the JPEG's header gives 60000x60000 pixels"), std::string::npos)
         << jpegError(dir + "/huge.jpg");
     EXPECT_NE(jpegError(dir + "/missing.jpg").find("cannot open"), std::string::npos);
+}
+
+TEST(Parallel, TilesAreTheSameOnAnyNumberOfThreadsAndEveryRun) {
+    // A body that batches its tile's work (the sampler's Embree streams) gives the same results
+    // only where the tiles are the same. The tiles are split down to the grain (so they are the
+    // same whatever the scheduling), and every pixel is in exactly one.
+    constexpr int W = 1021, H = 517, kGrain = 16;
+    auto tiles = [&](int threads, bool uneven) {
+        ThreadLimit limit(threads);
+        std::mutex m;
+        std::set<std::array<int, 4>> out;
+        std::vector<std::atomic<int>> covered(size_t(W) * H);
+        parallelTiles(W, H, kGrain, [&](int x0, int x1, int y0, int y1) {
+            for (int y = y0; y < y1; ++y)
+                for (int x = x0; x < x1; ++x) ++covered[size_t(y) * W + x];
+            volatile double spin = 0;  // uneven work, so that threads steal
+            if (uneven)
+                for (int k = 0; k < ((x0 * 7 + y0 * 3) % 5) * 2000; ++k) spin = spin + k;
+            std::lock_guard<std::mutex> lock(m);
+            out.insert({x0, x1, y0, y1});
+        });
+        for (const auto& c : covered) EXPECT_EQ(c.load(), 1);
+        return out;
+    };
+    const auto one = tiles(1, false);
+    for (const auto& [x0, x1, y0, y1] : one) {
+        EXPECT_LE(x1 - x0, kGrain);
+        EXPECT_LE(y1 - y0, kGrain);
+    }
+    for (int run = 0; run < 3; ++run) {
+        EXPECT_EQ(tiles(2, run % 2 == 0), one);
+        EXPECT_EQ(tiles(4, run % 2 == 1), one);
+    }
 }
