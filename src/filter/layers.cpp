@@ -2,9 +2,11 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cassert>
 #include <cmath>
 #include <vector>
 
+#include "core/memory.h"
 #include "core/parallel.h"
 #include "core/sampler.h"
 
@@ -23,7 +25,9 @@ struct Gathered {
     uint32_t pixel;             // where it was taken (row-major)
     int8_t surface;
     bool moving;
+    uint16_t bin;  // its slope bin in its class's histogram (splitLayers)
 };
+static_assert(sizeof(Gathered) == 52, "the bin fits in what was padding");
 
 /// A layer whose slopes spread less than this (pixels per unit lens coordinate) is sheared with
 /// its mean slope alone; a wider one's rays take the slope of the surface they find.
@@ -112,6 +116,13 @@ inline bool isSharp(float c, float spread, float motion, const LayerOptions& o) 
     return trueBlur < kCellBlur + sqr(o.sigmaMin);
 }
 
+/// The cell of a grid whose cell (i, j) covers the pixel [gx0 + i, gx0 + i + 1) x [gy0 + j, gy0 + j
+/// + 1) (gw x gh cells, row-major) that holds point p; -1 off the grid.
+inline int gridCell(int gx0, int gy0, int gw, int gh, Vec2f p) {
+    const int i = int(std::floor(p.x)) - gx0, j = int(std::floor(p.y)) - gy0;
+    return i < 0 || j < 0 || i >= gw || j >= gh ? -1 : j * gw + i;
+}
+
 struct Layer {
     double sumC = 0, sumMx = 0, sumMy = 0, sumInvDepth = 0;
     float cMin = kInf, cMax = -kInf;
@@ -184,10 +195,7 @@ struct Layer {
         const float dt = s.t - 0.5f;
         return {s.x + c * s.u - motionX * dt, s.y - c * s.v - motionY * dt};
     }
-    int cellIndex(Vec2f p) const {
-        const int i = int(std::floor(p.x)) - gx0, j = int(std::floor(p.y)) - gy0;
-        return i < 0 || j < 0 || i >= gw || j >= gh ? -1 : j * gw + i;
-    }
+    int cellIndex(Vec2f p) const { return gridCell(gx0, gy0, gw, gh, p); }
     int timeBin(float t) const { return std::min(timeBins - 1, int(t * float(timeBins))); }
 
     void buildCovered() {
@@ -240,7 +248,7 @@ struct Split {
     /// The layer (index into `layers`) of sample s.
     int layerOf(const Gathered& s) const {
         const Histogram& h = hist[s.moving];
-        return rank[h.base + h.binLayer[h.bin(s.c)]];
+        return rank[h.base + h.binLayer[s.bin]];
     }
 };
 
@@ -297,7 +305,8 @@ int mergeSharpRuns(Split::Histogram& h, int nLayers, const LayerOptions& o) {
 /// megabytes: each pass is a trip through memory; three passes, with one to set each sample's
 /// layer and one to renumber it front to back, were a tenth of an MC render of
 /// docs/motion.json); the splat takes each sample's layer from its bin (Split::layerOf).
-void splitLayers(const std::vector<Gathered>& g, const SlopeRange (&range)[2], const LayerOptions& o, Split& split) {
+template <class Samples>
+void splitLayers(Samples& g, const SlopeRange (&range)[2], const LayerOptions& o, Split& split) {
     auto& hist = split.hist;
     for (int moving = 0; moving < 2; ++moving) {
         const SlopeRange& r = range[moving];
@@ -335,8 +344,9 @@ void splitLayers(const std::vector<Gathered>& g, const SlopeRange (&range)[2], c
         h.cMax[r.bin] = std::max(h.cMax[r.bin], r.cMax);
         r = Run{};
     };
-    for (const Gathered& s : g) {
+    for (Gathered& s : g) {
         const int b = hist[s.moving].bin(s.c);
+        s.bin = uint16_t(b);
         Run& r = run[s.moving];
         if (b != r.bin) {
             flush(s.moving);
@@ -409,10 +419,12 @@ void splitLayers(const std::vector<Gathered>& g, const SlopeRange (&range)[2], c
 }
 
 /// Separable Gaussian of `sigma` cells over channels [c0, c1) of the `stride` interleaved
-/// channels of `acc` (gw x gh); c1 < 0: to the last.
-void smooth(std::vector<float>& acc, int gw, int gh, int stride, float sigma, int c0 = 0, int c1 = -1) {
-    if (c1 < 0) c1 = stride;
-    const int n = c1 - c0;
+/// channels of `acc` (gw x gh); c1 < 0: to the last. kChannels > 0: c1 - c0 known at compile
+/// time (the common runs: the loops over channels unrolled and vectorised; the same sums in the
+/// same order, so the same bytes as the general loop).
+template <int kChannels>
+void smoothRun(std::vector<float>& acc, int gw, int gh, int stride, float sigma, int c0, int c1) {
+    const int n = kChannels > 0 ? kChannels : c1 - c0;
     const int r = int(std::ceil(3.f * sigma));
     std::vector<float> w(2 * r + 1);
     for (int k = -r; k <= r; ++k) w[k + r] = std::exp(-0.5f * float(k * k) / (sigma * sigma));
@@ -423,7 +435,8 @@ void smooth(std::vector<float>& acc, int gw, int gh, int stride, float sigma, in
             float* out = &tmp[(size_t(j) * gw + i) * n];
             for (int k = std::max(-r, -i); k <= std::min(r, gw - 1 - i); ++k) {
                 const float* in = &acc[(size_t(j) * gw + i + k) * stride + c0];
-                for (int ch = 0; ch < n; ++ch) out[ch] += w[k + r] * in[ch];
+                const float wk = w[k + r];
+                for (int ch = 0; ch < n; ++ch) out[ch] += wk * in[ch];
             }
         }
     for (size_t q = 0; q < cells; ++q) std::fill_n(&acc[q * stride + c0], n, 0.f);
@@ -435,6 +448,17 @@ void smooth(std::vector<float>& acc, int gw, int gh, int stride, float sigma, in
             for (int i = 0; i < gw; ++i)
                 for (int ch = 0; ch < n; ++ch) out[size_t(i) * stride + ch] += wk * in[size_t(i) * n + ch];
         }
+}
+void smooth(std::vector<float>& acc, int gw, int gh, int stride, float sigma, int c0 = 0, int c1 = -1) {
+    if (c1 < 0) c1 = stride;
+    switch (c1 - c0) {
+        case 1: return smoothRun<1>(acc, gw, gh, stride, sigma, c0, c1);
+        case 2: return smoothRun<2>(acc, gw, gh, stride, sigma, c0, c1);
+        case 3: return smoothRun<3>(acc, gw, gh, stride, sigma, c0, c1);
+        case 4: return smoothRun<4>(acc, gw, gh, stride, sigma, c0, c1);
+        case 6: return smoothRun<6>(acc, gw, gh, stride, sigma, c0, c1);
+        default: return smoothRun<0>(acc, gw, gh, stride, sigma, c0, c1);
+    }
 }
 
 /// Per cell: alpha = N / D and, premultiplied by it, the radiance RGB / W of each time bin.
@@ -717,7 +741,9 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
     const int apronTiles = (o.maxReach + T - 1) / T;
     const float pad = std::ceil(3.f * o.sigmaMax) + 2.f;
     parallelTiles(tilesX, tilesY, 1, [&](int tx0, int tx1, int ty0, int ty1) {
-        std::vector<Gathered> g;
+        // Written whole before it is read (the gather below), so left unwritten when it grows;
+        // huge pages for a tile's megabytes (LargeAllocator).
+        std::vector<Gathered, UnwrittenAllocator<Gathered>> g;
         Split split;
         for (int ty = ty0; ty < ty1; ++ty)
             for (int tx = tx0; tx < tx1; ++tx) {
@@ -738,7 +764,8 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                 size_t expected = 0;
                 for (int y = ry0; y < ry1; ++y)
                     for (int x = rx0; x < rx1; ++x) expected += lf.count(size_t(y) * W + x);
-                g.reserve(expected);
+                g.resize(expected);
+                Gathered* next = g.data();
                 // The slopes of the still and the moving samples, kept in registers while the
                 // samples are read (as range[moving].add(c) they went through memory, a store
                 // and a load per sample on the gather's critical path).
@@ -772,9 +799,10 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                             hi[0] = !mv && c > hi[0] ? c : hi[0];
                             lo[1] = mv && c < lo[1] ? c : lo[1];
                             hi[1] = mv && c > hi[1] ? c : hi[1];
-                            g.push_back(a);
+                            *next++ = a;
                         });
                     }
+                assert(next == g.data() + g.size());  // every sample counted was read
                 gatheredTotal += g.size();
                 const SlopeRange range[2] = {{lo[0], hi[0]}, {lo[1], hi[1]}};
                 if (g.empty()) {
@@ -805,7 +833,7 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                 // variants tried (other slopes, moving layers, the pixel's unfiltered light) are
                 // in docs/layers.md, "Own light where the filtered light is another point's" and
                 // "Every sample its own light where the blur is large".
-                auto radianceOf = [&](const Gathered& s, const Layer& l) {
+                auto radianceOf = [&](const Gathered& s, const auto& l) {  // l: a Layer, or its SplatTarget
                     const float c = std::abs(l.c);
                     const bool own = !l.sharp && !l.moving &&
                                      (s.surface > 0 || (s.surface == 0 && (c >= kOwnLightAll || (mixed[s.pixel] && c >= kOwnLightSlope))));
@@ -878,34 +906,49 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                         motionAcc[k].assign(size_t(layers[k].gw) * layers[k].gh * 3, 0.f);
                         anyMotionGrid = true;
                     }
+                // What the splat reads of each layer, packed (the Layer is hundreds of bytes, and
+                // every sample visits every layer in front of its own); a moving layer with a
+                // motion grid takes its D in the pass below (`later`).
+                struct SplatTarget {
+                    float c, mx, my;
+                    int gx0, gy0, gw, gh, accStride, timeBins;
+                    bool sharp, moving, later;
+                    float *acc, *d, *motion;
+                    int cellIndex(Vec2f p) const { return gridCell(gx0, gy0, gw, gh, p); }
+                };
+                std::vector<SplatTarget> target(layers.size());
+                for (size_t k = 0; k < layers.size(); ++k) {
+                    Layer& l = layers[k];
+                    target[k] = {l.c,         l.mx,      l.my,      l.gx0,           l.gy0,         l.gw,
+                                 l.gh,        l.accStride(), l.timeBins, l.sharp,     l.moving,      !motionAcc[k].empty(),
+                                 l.acc.data(), l.accD.data(), motionAcc[k].empty() ? nullptr : motionAcc[k].data()};
+                }
                 for (const Gathered& s : g) {
                     const int sl = split.layerOf(s);
-                    // D of the layers in front, at their shear: where this sample shows that
-                    // they do not cover.
+                    // D of the layers in front, at their shear (Layer::sharpPosition,
+                    // Layer::cellIndex): where this sample shows that they do not cover.
+                    const float dt = s.t - 0.5f;
                     for (int k = 0; k < sl; ++k) {
-                        Layer& l = layers[k];
-                        if (!motionAcc[k].empty()) continue;
-                        const int ci = l.cellIndex(l.sharpPosition(s));
-                        if (ci >= 0) l.accD[ci] += 1.f;
+                        const SplatTarget& l = target[size_t(k)];
+                        if (l.later) continue;
+                        const int ci = l.cellIndex(l.sharp ? Vec2f{s.x, s.y} : Vec2f{s.x + l.c * s.u - l.mx * dt, s.y - l.c * s.v - l.my * dt});
+                        if (ci >= 0) l.d[ci] += 1.f;
                     }
                     // Its own layer's N, D, W and radiance at its own trajectory's point.
-                    Layer& l = layers[sl];
-                    Vec2f own{s.x, s.y};
-                    if (!l.sharp) {
-                        const float dt = s.t - 0.5f;
-                        own = {s.x + s.c * s.u - s.mx * dt, s.y - s.c * s.v - s.my * dt};
-                    }
+                    const SplatTarget& l = target[size_t(sl)];
+                    const Vec2f own = l.sharp ? Vec2f{s.x, s.y} : Vec2f{s.x + s.c * s.u - s.mx * dt, s.y - s.c * s.v - s.my * dt};
                     const int ci = l.cellIndex(own);
                     if (ci < 0) continue;
-                    l.acc[size_t(ci) * l.accStride()] += 1.f;
-                    l.accD[ci] += 1.f;
-                    l.acc[size_t(ci) * l.accStride() + 1] += s.c;
-                    if (!motionAcc[size_t(sl)].empty()) {
-                        float* m = &motionAcc[size_t(sl)][size_t(ci) * 3];
+                    float* cellAcc = l.acc + size_t(ci) * l.accStride;
+                    cellAcc[0] += 1.f;
+                    l.d[ci] += 1.f;
+                    cellAcc[1] += s.c;
+                    if (l.motion) {
+                        float* m = l.motion + size_t(ci) * 3;
                         m[0] += 1.f, m[1] += s.mx, m[2] += s.my;
                     }
                     const Vec3f radiance = radianceOf(s, l);
-                    float* a = &l.acc[size_t(ci) * l.accStride() + 2 + 4 * l.timeBin(s.t)];
+                    float* a = cellAcc + 2 + 4 * std::min(l.timeBins - 1, int(s.t * float(l.timeBins)));  // Layer::timeBin
                     a[0] += 1.f;
                     a[1] += radiance.x;
                     a[2] += radiance.y;
@@ -1045,6 +1088,12 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                                 ray.hit[j] = -1;
                             }
                             for (const Active& a : active) {
+                                // Once every ray has stopped (T < 1e-4) the layers behind add
+                                // nothing (composite stores nothing for a stopped ray): the
+                                // same image, without their lookups.
+                                bool live = false;
+                                for (int j = j0; j < j1; ++j) live |= ray.trans[j] >= 1e-4f;
+                                if (!live) break;
                                 const Layer& l = *a.layer;
                                 const int index = int(&a - active.data());
                                 auto take = [&](int j, const Lookup& v) {
