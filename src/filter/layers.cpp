@@ -122,6 +122,14 @@ inline int gridCell(int gx0, int gy0, int gw, int gh, Vec2f p) {
     const int i = int(std::floor(p.x)) - gx0, j = int(std::floor(p.y)) - gy0;
     return i < 0 || j < 0 || i >= gw || j >= gh ? -1 : j * gw + i;
 }
+/// Where sample s lies in the sharp image of slope c and screen motion (mx, my): y = x + c u -
+/// m (t - 1/2) (film y: y - c v - m_y (t - 1/2)).
+inline Vec2f shearOf(const Gathered& s, float c, float mx, float my) {
+    const float dt = s.t - 0.5f;
+    return {s.x + c * s.u - mx * dt, s.y - c * s.v - my * dt};
+}
+/// The time bin of shutter time t among `bins`.
+inline int timeBinOf(int bins, float t) { return std::min(bins - 1, int(t * float(bins))); }
 
 struct Layer {
     double sumC = 0, sumMx = 0, sumMy = 0, sumInvDepth = 0;
@@ -191,12 +199,9 @@ struct Layer {
 
     Vec2f sharpPosition(const Gathered& s) const { return sharp ? Vec2f{s.x, s.y} : sharpPosition(s, mx, my); }
     /// The blurred layer's shear of sample s with the screen motion (motionX, motionY).
-    Vec2f sharpPosition(const Gathered& s, float motionX, float motionY) const {
-        const float dt = s.t - 0.5f;
-        return {s.x + c * s.u - motionX * dt, s.y - c * s.v - motionY * dt};
-    }
+    Vec2f sharpPosition(const Gathered& s, float motionX, float motionY) const { return shearOf(s, c, motionX, motionY); }
     int cellIndex(Vec2f p) const { return gridCell(gx0, gy0, gw, gh, p); }
-    int timeBin(float t) const { return std::min(timeBins - 1, int(t * float(timeBins))); }
+    int timeBin(float t) const { return timeBinOf(timeBins, t); }
 
     void buildCovered() {
         const int cs = cellStride();
@@ -908,35 +913,34 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                     }
                 // What the splat reads of each layer, packed (the Layer is hundreds of bytes, and
                 // every sample visits every layer in front of its own); a moving layer with a
-                // motion grid takes its D in the pass below (`later`).
+                // motion grid (`motion`) takes its D in the pass below.
                 struct SplatTarget {
                     float c, mx, my;
                     int gx0, gy0, gw, gh, accStride, timeBins;
-                    bool sharp, moving, later;
+                    bool sharp, moving;
                     float *acc, *d, *motion;
                     int cellIndex(Vec2f p) const { return gridCell(gx0, gy0, gw, gh, p); }
                 };
                 std::vector<SplatTarget> target(layers.size());
                 for (size_t k = 0; k < layers.size(); ++k) {
                     Layer& l = layers[k];
-                    target[k] = {l.c,         l.mx,      l.my,      l.gx0,           l.gy0,         l.gw,
-                                 l.gh,        l.accStride(), l.timeBins, l.sharp,     l.moving,      !motionAcc[k].empty(),
-                                 l.acc.data(), l.accD.data(), motionAcc[k].empty() ? nullptr : motionAcc[k].data()};
+                    target[k] = {l.c,        l.mx,         l.my,      l.gx0,     l.gy0,       l.gw,
+                                 l.gh,       l.accStride(), l.timeBins, l.sharp,  l.moving,    l.acc.data(),
+                                 l.accD.data(), motionAcc[k].empty() ? nullptr : motionAcc[k].data()};
                 }
                 for (const Gathered& s : g) {
                     const int sl = split.layerOf(s);
-                    // D of the layers in front, at their shear (Layer::sharpPosition,
-                    // Layer::cellIndex): where this sample shows that they do not cover.
-                    const float dt = s.t - 0.5f;
+                    // D of the layers in front, at their shear (as Layer::sharpPosition): where this
+                    // sample shows that they do not cover.
                     for (int k = 0; k < sl; ++k) {
                         const SplatTarget& l = target[size_t(k)];
-                        if (l.later) continue;
-                        const int ci = l.cellIndex(l.sharp ? Vec2f{s.x, s.y} : Vec2f{s.x + l.c * s.u - l.mx * dt, s.y - l.c * s.v - l.my * dt});
+                        if (l.motion) continue;
+                        const int ci = l.cellIndex(l.sharp ? Vec2f{s.x, s.y} : shearOf(s, l.c, l.mx, l.my));
                         if (ci >= 0) l.d[ci] += 1.f;
                     }
                     // Its own layer's N, D, W and radiance at its own trajectory's point.
                     const SplatTarget& l = target[size_t(sl)];
-                    const Vec2f own = l.sharp ? Vec2f{s.x, s.y} : Vec2f{s.x + s.c * s.u - s.mx * dt, s.y - s.c * s.v - s.my * dt};
+                    const Vec2f own = l.sharp ? Vec2f{s.x, s.y} : shearOf(s, s.c, s.mx, s.my);
                     const int ci = l.cellIndex(own);
                     if (ci < 0) continue;
                     float* cellAcc = l.acc + size_t(ci) * l.accStride;
@@ -948,7 +952,7 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                         m[0] += 1.f, m[1] += s.mx, m[2] += s.my;
                     }
                     const Vec3f radiance = radianceOf(s, l);
-                    float* a = cellAcc + 2 + 4 * std::min(l.timeBins - 1, int(s.t * float(l.timeBins)));  // Layer::timeBin
+                    float* a = cellAcc + 2 + 4 * timeBinOf(l.timeBins, s.t);
                     a[0] += 1.f;
                     a[1] += radiance.x;
                     a[2] += radiance.y;
