@@ -1,8 +1,9 @@
 // The sampling stage's ceiling (issue 29): the rays one MC render asks Embree for, recorded by
 // kind (render::PathSampler::logRays), traced again by Embree alone, with no shading, no random
-// numbers and no bookkeeping. Each kind is traced three ways: one ray at a time (rtcIntersect1 /
-// rtcOccluded1), in 16-wide packets (rtcIntersect16 / rtcOccluded16: one pixel's batch), and as
-// streams of 256 (rtcIntersect1M / rtcOccluded1M: 16 pixels' samples). BM_EmbreeCeiling/wedge traces every kind
+// numbers and no bookkeeping. Each kind is traced five ways: one ray at a time (rtcIntersect1 /
+// rtcOccluded1), in 16-wide packets (rtcIntersect16 / rtcOccluded16: one pixel's batch), in
+// 8-wide packets (AVX2's width), and as streams of 256 (rtcIntersect1M / rtcOccluded1M: 16
+// pixels' samples), incoherent and coherent (Embree then packs the stream into packets itself). BM_EmbreeCeiling/wedge traces every kind
 // the way the sampler does, BM_EmbreeCeiling/best each kind its fastest way: their Mrays/s over
 // BM_Sampling's is the fraction of Embree's own speed that wedge's sampling reaches.
 // Run: build/bench/wedge_bench --benchmark_filter='Embree|Sampling/sponza'
@@ -22,7 +23,7 @@ using namespace wedge;
 namespace {
 
 using Kind = scene::RayLog::Kind;
-enum class Mode { kSingle, kPacket, kStream };
+enum class Mode { kSingle, kPacket, kStream, kCoherentStream, kPacket8 };
 
 struct Recorded {
     std::unique_ptr<scene::Scene> scene;
@@ -59,12 +60,49 @@ void fill(const scene::RaySegment& r, RTCRay& ray) {
     ray.flags = 0;
 }
 
+/// Packets of W rays (Embree's RTCRayHit8 / RTCRayHit16): how many hit.
+void tracePacket(int* valid, RTCScene scene, RTCIntersectContext& ctx, RTCRayHit8& rh, bool occlusion) {
+    if (occlusion) rtcOccluded8(valid, scene, &ctx, &rh.ray);
+    else rtcIntersect8(valid, scene, &ctx, &rh);
+}
+void tracePacket(int* valid, RTCScene scene, RTCIntersectContext& ctx, RTCRayHit16& rh, bool occlusion) {
+    if (occlusion) rtcOccluded16(valid, scene, &ctx, &rh.ray);
+    else rtcIntersect16(valid, scene, &ctx, &rh);
+}
+template <class RayHitN, size_t W>
+size_t tracePackets(RTCScene scene, RTCIntersectContext& ctx, const std::vector<scene::RaySegment>& rays, bool occlusion) {
+    alignas(64) RayHitN rh;
+    alignas(64) int valid[W];
+    size_t hits = 0;
+    for (size_t b = 0; b < rays.size(); b += W) {
+        const size_t n = std::min(W, rays.size() - b);
+        for (size_t i = 0; i < W; ++i) {
+            const auto& r = rays[b + std::min(i, n - 1)];
+            valid[i] = i < n ? -1 : 0;
+            rh.ray.org_x[i] = r.org.x; rh.ray.org_y[i] = r.org.y; rh.ray.org_z[i] = r.org.z;
+            rh.ray.dir_x[i] = r.dir.x; rh.ray.dir_y[i] = r.dir.y; rh.ray.dir_z[i] = r.dir.z;
+            rh.ray.tnear[i] = 0.f;
+            rh.ray.tfar[i] = r.tFar;
+            rh.ray.time[i] = r.time;
+            rh.ray.mask[i] = 0xffffffffu;
+            rh.ray.id[i] = unsigned(i);
+            rh.ray.flags[i] = 0;
+            rh.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
+            rh.hit.instID[0][i] = RTC_INVALID_GEOMETRY_ID;
+        }
+        tracePacket(valid, scene, ctx, rh, occlusion);
+        for (size_t i = 0; i < n; ++i) hits += occlusion ? rh.ray.tfar[i] < 0 : rh.hit.geomID[i] != RTC_INVALID_GEOMETRY_ID;
+    }
+    return hits;
+}
+
 /// Traces every ray of `kind` once in `mode`; returns how many hit (so nothing is optimised away).
 size_t traceAll(RTCScene scene, const std::vector<scene::RaySegment>& rays, Kind kind, Mode mode) {
     const bool occlusion = kind == Kind::kShadow || kind == Kind::kBounceShadow;
     RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
-    ctx.flags = kind == Kind::kPrimary ? RTC_INTERSECT_CONTEXT_FLAG_COHERENT : RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
+    ctx.flags = kind == Kind::kPrimary || mode == Mode::kCoherentStream ? RTC_INTERSECT_CONTEXT_FLAG_COHERENT
+                                                                         : RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
     size_t hits = 0;
     if (mode == Mode::kSingle) {
         for (const auto& r : rays) {
@@ -81,32 +119,9 @@ size_t traceAll(RTCScene scene, const std::vector<scene::RaySegment>& rays, Kind
             }
         }
     } else if (mode == Mode::kPacket) {
-        alignas(64) RTCRayHit16 rh;
-        alignas(64) int valid[16];
-        for (size_t b = 0; b < rays.size(); b += 16) {
-            const size_t n = std::min<size_t>(16, rays.size() - b);
-            for (size_t i = 0; i < 16; ++i) {
-                const auto& r = rays[b + std::min(i, n - 1)];
-                valid[i] = i < n ? -1 : 0;
-                rh.ray.org_x[i] = r.org.x; rh.ray.org_y[i] = r.org.y; rh.ray.org_z[i] = r.org.z;
-                rh.ray.dir_x[i] = r.dir.x; rh.ray.dir_y[i] = r.dir.y; rh.ray.dir_z[i] = r.dir.z;
-                rh.ray.tnear[i] = 0.f;
-                rh.ray.tfar[i] = r.tFar;
-                rh.ray.time[i] = r.time;
-                rh.ray.mask[i] = 0xffffffffu;
-                rh.ray.id[i] = unsigned(i);
-                rh.ray.flags[i] = 0;
-                rh.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
-                rh.hit.instID[0][i] = RTC_INVALID_GEOMETRY_ID;
-            }
-            if (occlusion) {
-                rtcOccluded16(valid, scene, &ctx, &rh.ray);
-                for (size_t i = 0; i < n; ++i) hits += rh.ray.tfar[i] < 0;
-            } else {
-                rtcIntersect16(valid, scene, &ctx, &rh);
-                for (size_t i = 0; i < n; ++i) hits += rh.hit.geomID[i] != RTC_INVALID_GEOMETRY_ID;
-            }
-        }
+        hits += tracePackets<RTCRayHit16, 16>(scene, ctx, rays, occlusion);
+    } else if (mode == Mode::kPacket8) {
+        hits += tracePackets<RTCRayHit8, 8>(scene, ctx, rays, occlusion);
     } else {
         constexpr size_t kStream = 256;
         std::vector<RTCRayHit> rh(kStream);
@@ -138,10 +153,10 @@ void BM_EmbreeAlone(benchmark::State& state) {
     state.counters["Mrays/s"] = benchmark::Counter(double(rays.size()) * 1e-6, benchmark::Counter::kIsIterationInvariantRate);
     state.counters["rays"] = double(rays.size());
     static const char* kinds[] = {"primary", "shadow", "bounce", "bounce-shadow"};
-    static const char* modes[] = {"single", "packet16", "stream256"};
+    static const char* modes[] = {"single", "packet16", "stream256", "stream256-coherent", "packet8"};
     state.SetLabel(std::string(kinds[kind]) + " " + modes[int(mode)]);
 }
-BENCHMARK(BM_EmbreeAlone)->ArgsProduct({{0, 1, 2, 3}, {0, 1, 2}})->Unit(benchmark::kMillisecond)->MinTime(1.0);
+BENCHMARK(BM_EmbreeAlone)->ArgsProduct({{0, 1, 2, 3}, {0, 1, 2, 3, 4}})->Unit(benchmark::kMillisecond)->MinTime(1.0);
 
 /// All kinds together: arg 0 the sampler's modes (primary rays in one pixel's packets, the
 /// others in streams of up to 256), arg 1 each
@@ -154,14 +169,14 @@ void BM_EmbreeCeiling(benchmark::State& state) {
         label = "fastest:";
         for (int k = 0; k < scene::RayLog::kKinds; ++k) {
             double fastest = 1e30;
-            for (Mode m : {Mode::kSingle, Mode::kPacket, Mode::kStream})
+            for (Mode m : {Mode::kSingle, Mode::kPacket, Mode::kStream, Mode::kCoherentStream, Mode::kPacket8})
                 for (int pass = 0; pass < 3; ++pass) {
                     const auto t0 = std::chrono::steady_clock::now();
                     benchmark::DoNotOptimize(traceAll(r.scene->embree(), r.log.rays[k], Kind(k), m));
                     const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
                     if (s < fastest) fastest = s, modes[k] = m;
                 }
-            static const char* names[] = {" single", " packet16", " stream256"};
+            static const char* names[] = {" single", " packet16", " stream256", " stream256-coherent", " packet8"};
             label += names[int(modes[k])];
         }
     }
