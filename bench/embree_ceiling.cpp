@@ -60,7 +60,7 @@ void fill(const scene::RaySegment& r, RTCRay& ray) {
     ray.flags = 0;
 }
 
-/// Packets of W rays (Embree's RTCRayHit8 / RTCRayHit16): how many hit.
+/// One packet's query, for Embree's RTCRayHit8 and RTCRayHit16.
 void tracePacket(int* valid, RTCScene scene, RTCIntersectContext& ctx, RTCRayHit8& rh, bool occlusion) {
     if (occlusion) rtcOccluded8(valid, scene, &ctx, &rh.ray);
     else rtcIntersect8(valid, scene, &ctx, &rh);
@@ -69,6 +69,7 @@ void tracePacket(int* valid, RTCScene scene, RTCIntersectContext& ctx, RTCRayHit
     if (occlusion) rtcOccluded16(valid, scene, &ctx, &rh.ray);
     else rtcIntersect16(valid, scene, &ctx, &rh);
 }
+/// Every ray in packets of W (the last one padded with inactive lanes); returns how many hit.
 template <class RayHitN, size_t W>
 size_t tracePackets(RTCScene scene, RTCIntersectContext& ctx, const std::vector<scene::RaySegment>& rays, bool occlusion) {
     alignas(64) RayHitN rh;

@@ -70,9 +70,10 @@ for peer_label in ("pathtracer, ambient", "pathtracer, point"):
         print(f"  {label} / {peer_label}: {med(rows[label][0]) / pm:.2f}x the rays per second, "
               f"{pn / med(rows[label][1]):.2f}x the path samples per second")
 print("conference 720x720")
+frames = {key: [1 / f for f, _ in peer(key)] for key in ("fa", "fp")}
 for key, label in (("fa", "ambient"), ("fp", "point")):
-    print(f"  embree pathtracer ({label}), a noisy 16-spp frame, s:", seq([1 / f for f, _ in peer(key)]))
-fa, fp = med(1 / f for f, _ in peer("fa")), med(1 / f for f, _ in peer("fp"))
+    print(f"  embree pathtracer ({label}), a noisy 16-spp frame, s:", seq(frames[key]))
+fa, fp = med(frames["fa"]), med(frames["fp"])
 for m in ("aaf", "maaf"):
     st = [json.load(open(f"{tmp}/{m}{i}.json")) for i in runs]
     total = med(r["seconds"]["total"] for r in st)

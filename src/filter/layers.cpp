@@ -128,6 +128,10 @@ inline Vec2f shearOf(const Gathered& s, float c, float mx, float my) {
     const float dt = s.t - 0.5f;
     return {s.x + c * s.u - mx * dt, s.y - c * s.v - my * dt};
 }
+/// Where sample s lies in a layer's grid: its own position in a sharp layer, else its shear.
+inline Vec2f layerPosition(const Gathered& s, bool sharp, float c, float mx, float my) {
+    return sharp ? Vec2f{s.x, s.y} : shearOf(s, c, mx, my);
+}
 /// The time bin of shutter time t among `bins`.
 inline int timeBinOf(int bins, float t) { return std::min(bins - 1, int(t * float(bins))); }
 
@@ -197,7 +201,7 @@ struct Layer {
     int accStride() const { return 2 + 4 * timeBins; }
     int cellStride() const { return 2 + 3 * timeBins; }  // ... and last the samples' mean slope there
 
-    Vec2f sharpPosition(const Gathered& s) const { return sharp ? Vec2f{s.x, s.y} : sharpPosition(s, mx, my); }
+    Vec2f sharpPosition(const Gathered& s) const { return layerPosition(s, sharp, c, mx, my); }
     /// The blurred layer's shear of sample s with the screen motion (motionX, motionY).
     Vec2f sharpPosition(const Gathered& s, float motionX, float motionY) const { return shearOf(s, c, motionX, motionY); }
     int cellIndex(Vec2f p) const { return gridCell(gx0, gy0, gw, gh, p); }
@@ -935,12 +939,12 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                     for (int k = 0; k < sl; ++k) {
                         const SplatTarget& l = target[size_t(k)];
                         if (l.motion) continue;
-                        const int ci = l.cellIndex(l.sharp ? Vec2f{s.x, s.y} : shearOf(s, l.c, l.mx, l.my));
+                        const int ci = l.cellIndex(layerPosition(s, l.sharp, l.c, l.mx, l.my));
                         if (ci >= 0) l.d[ci] += 1.f;
                     }
                     // Its own layer's N, D, W and radiance at its own trajectory's point.
                     const SplatTarget& l = target[size_t(sl)];
-                    const Vec2f own = l.sharp ? Vec2f{s.x, s.y} : shearOf(s, s.c, s.mx, s.my);
+                    const Vec2f own = layerPosition(s, l.sharp, s.c, s.mx, s.my);
                     const int ci = l.cellIndex(own);
                     if (ci < 0) continue;
                     float* cellAcc = l.acc + size_t(ci) * l.accStride;
