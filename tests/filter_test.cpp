@@ -345,6 +345,37 @@ TEST(MaafComponents, NoIndirectOuterComponentsWhereTheNearestBounceHitIsWithinTh
     }
 }
 
+TEST(MaafComponents, ShadowComponentsOnlyWhereTheSlopesWithinReachAgree) {
+    // MaafOptions::shadowSpan: a row of shadow pixels at slope 0.1 with one pixel at 0.25 (a
+    // second occluder, 2.5x steeper): the pixels within the window's radius of it along the row
+    // (and it) disagree at a span of 2, the others agree; a pixel without a shadow wedge does
+    // not, and a pixel on another surface neither counts for its neighbours nor they for it.
+    const int W = 40, H = 3;
+    Plane pl(W, H);
+    WedgeField wf;
+    wf.s1 = Image1f(W, H, 0.1f);
+    wf.s2 = Image1f(W, H, 0.1f);
+    const int steep = 20, off = 35, other = 5;
+    wf.s1(steep, 1) = wf.s2(steep, 1) = 0.25f;
+    wf.s2(off, 1) = kInf;  // lit: no wedge
+    pl.fb.object[size_t(1) * W + other - 4] = 1;  // another object, with a steep slope
+    wf.s1(other - 4, 1) = wf.s2(other - 4, 1) = 0.5f;
+    MaafOptions o;
+    o.maxRadius = 10;
+    o.shadowSpan = 2.f;
+    const Image<uint8_t> agree = shadowSlopesAgree(pl.fb, wf, o);
+    for (int x = 0; x < W; ++x) {
+        const bool expected = x != off && std::abs(x - steep) > o.maxRadius;
+        EXPECT_EQ(agree(x, 1) != 0, expected) << "x " << x;
+    }
+    // Along the column too: the pixel above the steep one disagrees, one 11 rows off would not.
+    EXPECT_EQ(agree(steep, 0), 0);
+    o.shadowSpan = 3.f;  // 2.5x within 3x: all agree but the lit pixel
+    const Image<uint8_t> loose = shadowSlopesAgree(pl.fb, wf, o);
+    EXPECT_NE(loose(steep, 1), 0);
+    EXPECT_EQ(loose(off, 1), 0);
+}
+
 TEST(MaafComponents, DilateBoxMarksEveryPixelWithinTheRadiusOfAMarkedOne) {
     // The region MAAF's sparse pipeline computes in: against a brute-force search, on scattered
     // marks (some at the borders) and radii from 0 to beyond the image.
@@ -899,6 +930,53 @@ TEST(MaafWeights, SamplingSpectraRemoveMostOfTheOuterComponentsBias) {
         EXPECT_LT(sampling, (aspect > 1 ? 0.5 : 0.95) * eq10) << "aspect " << aspect;
         EXPECT_LT(aaf, sampling) << "aspect " << aspect;
     }
+}
+
+TEST(MaafSample, LightCentreIsWhereTheReceiversUnoccludedLightIsCentred) {
+    // A 0.8 x 0.8 light 3 above a floor. Straight above the receiver its irradiance is centred
+    // on the light's centre; seen from 2.5 to the side, the near side is brighter (cos cos / r^2)
+    // and the centre moves towards the receiver: against a 400 x 400 midpoint sum of the same
+    // integrand, and for the same light as two triangles (a group's parts).
+    ViewGeometry::Light l;
+    const Vec3f corner{1.8f, 3.f, -0.4f}, e1{0.8f, 0.f, 0.f}, e2{0.f, 0.f, 0.8f};
+    l.center = corner + (e1 + e2) * 0.5f;
+    l.axisA = Vec3f(1.f, 0.f, 0.f);
+    l.axisB = Vec3f(0.f, 0.f, 1.f);
+    l.parts.push_back({corner, e1, e2, false, 1.f});
+    const Vec3f up{0.f, 1.f, 0.f};
+    auto brute = [&](const Vec3f& p) {
+        double sum = 0, sumA = 0, sumB = 0;
+        const int n = 400;
+        for (int i = 0; i < n; ++i)
+            for (int j = 0; j < n; ++j) {
+                const Vec3f q = corner + e1 * ((i + 0.5f) / n) + e2 * ((j + 0.5f) / n);
+                const Vec3f d = q - p;
+                const double r2 = lengthSquared(d), w = (d.y / std::sqrt(r2)) * (d.y / std::sqrt(r2)) / r2;
+                sum += w;
+                sumA += w * (q.x - l.center.x);
+                sumB += w * (q.z - l.center.z);
+            }
+        return Vec2f(float(sumA / sum), float(sumB / sum));
+    };
+    const Vec2f above = filter::lightIrradianceCentre(l, l.center - Vec3f(0.f, 3.f, 0.f), up);
+    EXPECT_NEAR(above.x, 0.f, 1e-5f);
+    EXPECT_NEAR(above.y, 0.f, 1e-5f);
+    const Vec3f side{-0.31f, 0.f, 0.1f};
+    const Vec2f c = filter::lightIrradianceCentre(l, side, up), b = brute(side);
+    EXPECT_LT(c.x, -0.03f);  // towards the receiver (-x): 0.035 of the light's 0.8
+    // (8 x 8 midpoints: 0.0005 off the fine sum here, 0.003 px of shadow shift.)
+    EXPECT_NEAR(c.x, b.x, 1e-3f);
+    EXPECT_NEAR(c.y, b.y, 1e-3f);
+    EXPECT_GT(c.y, 0.f);  // the receiver is at z = 0.1: towards +z
+    ViewGeometry::Light tris = l;
+    tris.parts = {{corner, e1, e2 + e1, true, 0.5f}, {corner, e1 + e2, e2, true, 0.5f}};
+    const Vec2f t = filter::lightIrradianceCentre(tris, side, up);
+    EXPECT_NEAR(t.x, b.x, 2e-3f);
+    EXPECT_NEAR(t.y, b.y, 2e-3f);
+    // A receiver facing away from the light gets none of it: the light's own centre.
+    const Vec2f away = filter::lightIrradianceCentre(l, side, -up);
+    EXPECT_EQ(away.x, 0.f);
+    EXPECT_EQ(away.y, 0.f);
 }
 
 TEST(MaafSample, PackedSampleGivesTheRecordsCoordinates) {

@@ -604,6 +604,44 @@ TEST(Render, MaafSparseComponentsGiveTheDenseImage) {
     }
 }
 
+TEST(Render, MaafSparseShadowComponentsGiveTheDenseImage) {
+    // A plank's narrow penumbra (no indirect light) with --maaf-shadow-components: the direct
+    // light's filter has outer components there (filter::maafDirectOuter decides which pixels
+    // first). Sparse and dense give the same pixels and the same image bytes; without shadow
+    // components (the default) none, and AAF's image.
+    const scene::Scene scene(parse(R"({
+      "camera": {"position": [-0.4, 2.0, 0.0], "look_at": [-0.4, 0, 0], "up": [0, 0, -1], "fov_y": 40, "resolution": [128, 48]},
+      "materials": {"floor": {"albedo": [0.7, 0.7, 0.7]}, "plank": {"albedo": [0.4, 0.3, 0.2]}},
+      "lights": [{"type": "parallelogram", "corner": [1.8, 3, -0.4], "edge1": [0.8, 0, 0], "edge2": [0, 0, 0.8], "radiance": [60, 60, 60]}],
+      "objects": [{"type": "quad", "corner": [-4, 0, 4], "edge1": [8, 0, 0], "edge2": [0, 0, -8], "material": "floor"},
+                  {"type": "box", "min": [0.0, 0.2, -2], "max": [0.3, 0.25, 2], "material": "plank"}],
+      "render": {"spp": 16, "seed": 1, "indirect": false}})"));
+    render::RenderOptions o;
+    o.quiet = true;
+    o.method = "maaf";
+    o.spp = 8;
+    o.seed = 4;
+    o.maafShadowComponents = true;
+    const render::RenderResult sparse = render::render(scene, o);
+    o.maafSparse = false;
+    const render::RenderResult dense = render::render(scene, o);
+    const double shadowOuter = sparse.figure("maaf_shadow_outer_pixels").value_or(-1);
+    EXPECT_GT(shadowOuter, 20);
+    EXPECT_EQ(shadowOuter, sparse.figure("maaf_outer_component_pixels").value_or(-2));  // no indirect light
+    EXPECT_EQ(shadowOuter, dense.figure("maaf_shadow_outer_pixels").value_or(-3));
+    ASSERT_EQ(sparse.color.size(), dense.color.size());
+    EXPECT_EQ(0, std::memcmp(sparse.color.data(), dense.color.data(), dense.color.size() * sizeof(Vec3f)));
+    o.maafSparse = true;
+    o.maafShadowComponents = false;
+    const render::RenderResult none = render::render(scene, o);
+    o.method = "aaf";
+    const render::RenderResult aaf = render::render(scene, o);
+    EXPECT_EQ(none.figure("maaf_outer_component_pixels").value_or(-1), 0.0);
+    ASSERT_EQ(none.color.size(), aaf.color.size());
+    EXPECT_EQ(0, std::memcmp(none.color.data(), aaf.color.data(), aaf.color.size() * sizeof(Vec3f)));
+    EXPECT_NE(0, std::memcmp(sparse.color.data(), aaf.color.data(), aaf.color.size() * sizeof(Vec3f)));
+}
+
 namespace {
 /// A path sample on surface `object` at depth 1 with the given direct light (albedo 1).
 render::TracedSample surfaceSample(uint32_t object, float light) {

@@ -57,6 +57,13 @@ void addMethodFlags(CLI::App& cmd, render::RenderOptions& r) {
     cmd.add_flag("!--maaf-dense", r.maafSparse,
                  "maaf: compute the indirect light's frames, components and accumulations in every pixel, not only "
                  "within the filter's window of the pixels with outer components (the same image; for checks)");
+    cmd.add_flag("--maaf-shadow-components", r.maafShadowComponents,
+                 "maaf: outer components in the direct light's (shadow) filter too, where the shadow slopes within "
+                 "the filter's reach span at most 1.5x (ahead of AAF on isolated penumbrae of 2-3 px; not the default: "
+                 "docs/maaf.md)");
+    cmd.add_flag("!--no-maaf-light-centre", r.maafLightCentre,
+                 "maaf: measure the direct light's sample coordinates from the light's centre, not from where each "
+                 "receiver's unoccluded light is centred on it (before 2026-11-28; only shadow components read them)");
     cmd.add_option("--maaf-weights", r.maafWeights,
                    "maaf: component weights mu_p: the sampling densities' spectra (default), eq. 10's Gaussian, or 1")
         ->check(CLI::IsMember({"sampling", "eq10", "unit"}));

@@ -74,15 +74,36 @@ AxisFrame indirectFrame(const FrameBuffers& fb, const ViewGeometry& view, size_t
     return makeFrame(s1, s2, view.right, fb.normal[p]);
 }
 
+namespace {
+
+/// Pixel p's direct frame from its tangent steps: the steps projected on the light's plane (a
+/// sphere light's: the one facing this receiver).
+AxisFrame directFrameFromSteps(const FrameBuffers& fb, const ViewGeometry& view, int light, size_t p, const Vec3f& s1,
+                               const Vec3f& s2) {
+    Vec3f lp = view.lights.empty() ? Vec3f(0, 1, 0) : view.lights[light].normal;
+    Vec3f lx = view.lights.empty() ? Vec3f(1, 0, 0) : view.lights[light].axisA;
+    if (!view.lights.empty() && view.lights[light].sphere) {
+        lp = normalize(view.lights[light].center - fb.position[p]);
+        lx = normalize(cross(lp, std::abs(lp.x) < 0.9f ? Vec3f(1, 0, 0) : Vec3f(0, 1, 0)));
+    }
+    Vec3f p1 = s1 - lp * dot(lp, s1), p2 = s2 - lp * dot(lp, s2);
+    return makeFrame(p1, p2, lx, lp);
+}
+
+}  // namespace
+
+AxisFrame directFrame(const FrameBuffers& fb, const ViewGeometry& view, size_t p) {
+    Vec3f s1, s2;
+    if (!tangentSteps(fb, view, p, s1, s2)) return {{view.right, -view.up}, {1, 1}};
+    return directFrameFromSteps(fb, view, dominantLight(view), p, s1, s2);
+}
+
 FilterFrames computeFrames(const FrameBuffers& fb, const ViewGeometry& view, bool withDirect, const Image<uint8_t>* where) {
     FilterFrames ff;
     if (withDirect) ff.direct = Image<AxisFrame>(fb.width, fb.height);
     ff.indirect = Image<AxisFrame>(fb.width, fb.height);
     ff.light = dominantLight(view);
-    const Vec3f nl = view.lights.empty() ? Vec3f(0, 1, 0) : view.lights[ff.light].normal;
-    const Vec3f la = view.lights.empty() ? Vec3f(1, 0, 0) : view.lights[ff.light].axisA;
     const Vec3f down = -view.up;
-    const bool sphere = !view.lights.empty() && view.lights[ff.light].sphere;
     parallelRows(fb.height, [&](int y) {
         for (int x = 0; x < fb.width; ++x) {
             size_t p = size_t(y) * fb.width + x;
@@ -93,18 +114,8 @@ FilterFrames computeFrames(const FrameBuffers& fb, const ViewGeometry& view, boo
                 ff.indirect[p] = {{view.right, down}, {1, 1}};
                 continue;
             }
-            const Vec3f n = fb.normal[p];
-            ff.indirect[p] = makeFrame(s1, s2, view.right, n);
-            if (!withDirect) continue;
-            // The light's plane; a sphere light's is the one facing this receiver.
-            const Vec3f P = fb.position[p];
-            Vec3f lp = nl, lx = la;
-            if (sphere) {
-                lp = normalize(view.lights[ff.light].center - P);
-                lx = normalize(cross(lp, std::abs(lp.x) < 0.9f ? Vec3f(1, 0, 0) : Vec3f(0, 1, 0)));
-            }
-            Vec3f p1 = s1 - lp * dot(lp, s1), p2 = s2 - lp * dot(lp, s2);
-            ff.direct[p] = makeFrame(p1, p2, lx, lp);
+            ff.indirect[p] = makeFrame(s1, s2, view.right, fb.normal[p]);
+            if (withDirect) ff.direct[p] = directFrameFromSteps(fb, view, ff.light, p, s1, s2);
         }
     });
     return ff;

@@ -33,6 +33,8 @@ FilterFrames computeFrames(const FrameBuffers& fb, const ViewGeometry& view, boo
 
 /// Pixel p's indirect frame, as computeFrames gives it, computed alone.
 AxisFrame indirectFrame(const FrameBuffers& fb, const ViewGeometry& view, size_t p);
+/// Pixel p's direct frame, as computeFrames gives it, computed alone.
+AxisFrame directFrame(const FrameBuffers& fb, const ViewGeometry& view, size_t p);
 /// At least both steps of pixel p's indirect frame, for less work than the frame (a quick
 /// rejection of pixels whose steps are too short for something).
 float indirectStepBound(const FrameBuffers& fb, const ViewGeometry& view, size_t p);

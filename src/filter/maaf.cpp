@@ -210,7 +210,92 @@ bool indirectInputs(const WedgeField& wf, const AxisFrame& frame, float object, 
     return true;
 }
 
+/// The light whose spectrum weighs the direct light's outer components: the only one the
+/// filters see (a lamp of many coplanar triangles is one, scene::lightGroups), if it is planar
+/// (a sphere's samples have no one plane to take y in: its direct filter is central, as with
+/// several).
+const ViewGeometry::Light* singlePlanarLight(const ViewGeometry& view) {
+    return view.lights.size() == 1 && !view.lights.front().sphere ? &view.lights.front() : nullptr;
+}
+
+/// The direct light's inputs of pixel p's axis k: the shadow wedge in the light plane.
+/// The outer components reproduce the sheared profile of one light (their weights are its
+/// spectrum, their y its coordinates): with several lights (groups), whose samples share a
+/// pixel's accumulations, the direct filter is the central component (axis-aligned). Measured
+/// on a floor, a box and a plank under a large and a small parallelogram (16 spp, 384x384,
+/// against 512-spp MC): the outer components gave relMSE 0.00495, worse than MC's 0.00278.
+/// False where it has no surface.
+bool directInputs(const WedgeField& wf, const AxisFrame& frame, float object, bool fallback, bool lens,
+                  const ViewGeometry::Light* single, const Image<uint8_t>* agree, size_t p, int k, const MaafOptions& o,
+                  AxisInputs& in) {
+    if (object < 0) return false;
+    in.lens = lens;
+    in.omegaU = o.lensOmega;
+    in.fallback = fallback || !single || !o.shadowComponents || (agree && !(*agree)[p]);
+    in.step = frame.step[k];
+    in.yWedge = wf.s2[p] < kInf;
+    in.omegaY = o.mu / wf.lightSigma[p];  // the light whose shadow this is (wedge_field.h)
+    in.sMin = std::max(wf.s2[p], 1e-4f);
+    in.sMax = std::max(wf.s1[p], wf.s2[p]);
+    in.suMin = wf.suMin[p] * in.step;
+    in.suMax = wf.suMax[p] * in.step;
+    in.light = single;  // with several lights the weights are unused (central only)
+    in.axis = frame.axis[k];
+    return true;
+}
+
 }  // namespace
+
+Image<uint8_t> shadowSlopesAgree(const FrameBuffers& fb, const WedgeField& wf, const MaafOptions& o) {
+    const int W = fb.width, H = fb.height;
+    Image<uint8_t> agree(W, H);
+    parallelRows(H, [&](int y) {
+        for (int x = 0; x < W; ++x) {
+            const size_t p = size_t(y) * W + x;
+            if (!(wf.s2[p] < kInf)) continue;
+            float lo = wf.s2[p], hi = std::max(wf.s1[p], wf.s2[p]);
+            auto visit = [&](int qx, int qy) {
+                if (qx < 0 || qy < 0 || qx >= W || qy >= H) return;
+                const size_t q = size_t(qy) * W + qx;
+                if (!(wf.s2[q] < kInf) || !sameSurface(fb, p, q, o.normalCos)) return;
+                lo = std::min(lo, wf.s2[q]);
+                hi = std::max(hi, std::max(wf.s1[q], wf.s2[q]));
+            };
+            for (int d = -o.maxRadius; d <= o.maxRadius; ++d) {
+                visit(x + d, y);
+                visit(x, y + d);
+            }
+            agree[p] = hi <= o.shadowSpan * std::max(lo, 1e-4f);
+        }
+    });
+    return agree;
+}
+
+Image<uint8_t> maafDirectOuter(const FrameBuffers& fb, const WedgeField& wf, const ViewGeometry& view, const MaafOptions& o,
+                               const Image<uint8_t>* agree) {
+    const int W = fb.width, H = fb.height;
+    const bool lens = view.apertureRadius > 0;
+    const ViewGeometry::Light* single = singlePlanarLight(view);
+    Image<uint8_t> outer(W, H);
+    if (o.pairs < 2 || !o.shadowComponents || !o.directEffect || !single) return outer;
+    parallelRows(H, [&](int y) {
+        for (int x = 0; x < W; ++x) {
+            const size_t p = size_t(y) * W + x;
+            // What needs no frame first: no surface, no shadow wedge, the focal plane, slopes
+            // that disagree (directInputs would make it central).
+            if (fb.object[p] < 0 || !(wf.s2[p] < kInf) || (agree && !(*agree)[p])) continue;
+            const bool fallback = focalFallback(fb, wf, lens, o, p);
+            if (fallback) continue;
+            const AxisFrame frame = directFrame(fb, view, p);
+            for (int k = 0; k < 2 && !outer[p]; ++k) {
+                AxisInputs in;
+                if (directInputs(wf, frame, fb.object[p], fallback, lens, single, agree, p, k, o, in))
+                    outer[p] = axisPairs(in, o) > 1;
+            }
+        }
+    });
+    return outer;
+}
 
 Image<uint8_t> maafIndirectOuter(const FrameBuffers& fb, const WedgeField& wf, const ViewGeometry& view, const MaafOptions& o) {
     const int W = fb.width, H = fb.height;
@@ -271,12 +356,9 @@ Image<uint8_t> dilateBox(const Image<uint8_t>& mask, int radius) {
 }
 
 MaafParams maafParams(const FrameBuffers& fb, const WedgeField& wf, const FilterFrames& frames, const ViewGeometry& view,
-                      const MaafOptions& o, const Image<uint8_t>* region) {
+                      const MaafOptions& o, const Image<uint8_t>* region, const Image<uint8_t>* shadowAgree) {
     const int W = fb.width, H = fb.height;
-    // The light whose spectrum weighs the outer components: the only one the filters see (below;
-    // a lamp of many coplanar triangles is one, scene::lightGroups), if it is planar (a sphere's
-    // samples have no one plane to take y in: its direct filter is central, as with several).
-    const ViewGeometry::Light* single = view.lights.size() == 1 && !view.lights.front().sphere ? &view.lights.front() : nullptr;
+    const ViewGeometry::Light* single = singlePlanarLight(view);
     const bool lens = view.apertureRadius > 0;
     Image1f fallback(W, H);
     parallelRows(H, [&](int y) {
@@ -291,37 +373,18 @@ MaafParams maafParams(const FrameBuffers& fb, const WedgeField& wf, const Filter
         Image1f object, footprint, fallback;
     };
     auto snap = std::make_shared<Snapshot>(Snapshot{fb.object, fb.footprint, fallback});
-    auto common = [snap, lens, o](size_t p, AxisInputs& in) {
-        if (snap->object[p] < 0) return false;
-        in.lens = lens;
-        in.omegaU = o.lensOmega;
-        in.fallback = snap->fallback[p] > 0;
-        return true;
-    };
-    // Direct: the shadow wedge in the light plane.
-    // The outer components reproduce the sheared profile of one light (their weights are its
-    // spectrum, their y its coordinates): with several lights (groups), whose samples share a
-    // pixel's accumulations, the direct filter is the central component (axis-aligned). Measured
-    // on a floor, a box and a plank under a large and a small parallelogram (16 spp, 384x384,
-    // against 512-spp MC): the outer components gave relMSE 0.00495, worse than MC's 0.00278.
-    auto direct = [&, common, single, o](size_t p, int k, MaafAxis& out) {
+    // Direct: the shadow wedge in the light plane (directInputs). The agreement mask is shared:
+    // the effect computes a pixel's axes again when they are asked for (MaafEffect::pixel).
+    std::shared_ptr<const Image<uint8_t>> agree;
+    if (shadowAgree) agree = std::make_shared<const Image<uint8_t>>(*shadowAgree);
+    auto direct = [&, snap, lens, single, agree, o](size_t p, int k, MaafAxis& out) {
         AxisInputs in;
-        if (!common(p, in)) {
+        if (!directInputs(wf, frames.direct[p], snap->object[p], snap->fallback[p] > 0, lens, single, agree.get(), p, k, o,
+                          in)) {
             out = MaafAxis{};
             out.pairs = 1;
             return;
         }
-        in.fallback = in.fallback || !single || !o.shadowComponents;
-        in.step = frames.direct[p].step[k];
-        in.yWedge = wf.s2[p] < kInf;
-        in.omegaY = o.mu / wf.lightSigma[p];  // the light whose shadow this is (wedge_field.h)
-        in.sMin = std::max(wf.s2[p], 1e-4f);
-        in.sMax = std::max(wf.s1[p], wf.s2[p]);
-        in.suMin = wf.suMin[p] * in.step;
-        in.suMax = wf.suMax[p] * in.step;
-        const Vec3f& axis = frames.direct[p].axis[k];
-        in.light = single;  // with several lights the weights are unused (central only)
-        in.axis = axis;
         out = buildAxis(in, o);
     };
     // Indirect: the bounce wedge (indirectInputs).
@@ -335,7 +398,7 @@ MaafParams maafParams(const FrameBuffers& fb, const WedgeField& wf, const Filter
         }
         out = buildAxis(in, o);
     };
-    return MaafParams{o.directEffect ? MaafEffect(W, H, direct) : MaafEffect(W, H), MaafEffect(W, H, indirect, region),
+    return MaafParams{o.directEffect ? MaafEffect(W, H, direct, region) : MaafEffect(W, H), MaafEffect(W, H, indirect, region),
                       std::move(fallback)};
 }
 
@@ -393,13 +456,44 @@ MaafSample MaafSample::pack(const SampleRecord& r, const ViewGeometry& view, int
     return m;
 }
 
+Vec2f lightIrradianceCentre(const ViewGeometry::Light& l, const Vec3f& p, const Vec3f& n) {
+    if (l.sphere || l.parts.empty()) return {0.f, 0.f};
+    constexpr int kGrid = 8;
+    double sum = 0, sumA = 0, sumB = 0;
+    for (const ViewGeometry::Light::Part& part : l.parts) {
+        const Vec3f ln = normalize(cross(part.edge1, part.edge2));
+        for (int i = 0; i < kGrid; ++i)
+            for (int j = 0; j < kGrid; ++j) {
+                float a = (float(i) + 0.5f) / kGrid, b = (float(j) + 0.5f) / kGrid;
+                if (part.triangle) {  // the square onto the triangle, uniform in area
+                    const float r = std::sqrt(a);
+                    a = 1.f - r;
+                    b = b * r;
+                }
+                const Vec3f q = part.corner + part.edge1 * a + part.edge2 * b;
+                const Vec3f d = q - p;
+                const float r2 = lengthSquared(d);
+                if (!(r2 > 0.f)) continue;
+                const float inv = 1.f / std::sqrt(r2);
+                const float w = std::max(0.f, dot(n, d) * inv) * std::abs(dot(ln, d) * inv) / r2 * part.share;
+                const Vec3f rel = q - l.center;
+                sum += w;
+                sumA += w * dot(rel, l.axisA);
+                sumB += w * dot(rel, l.axisB);
+            }
+    }
+    if (!(sum > 0)) return {0.f, 0.f};
+    return {float(sumA / sum), float(sumB / sum)};
+}
+
 void MaafSample::coordinates(const ViewGeometry& view, const AxisFrame& direct, const AxisFrame& indirect,
-                             float yDirect[2], float yIndirect[2], float u[2]) const {
+                             float yDirect[2], float yIndirect[2], float u[2], Vec2f lightCentre) const {
     const ViewGeometry::Light& l = view.lights[light];
     const Vec3f bounceDir =
         (visible & 2) ? octDecode(fromUnorm16(bounce[0]), fromUnorm16(bounce[1])) : Vec3f(0.f);
+    const float a = lightA - lightCentre.x, b = lightB - lightCentre.y;
     for (int k = 0; k < 2; ++k) {
-        yDirect[k] = lightA * dot(l.axisA, direct.axis[k]) + lightB * dot(l.axisB, direct.axis[k]);
+        yDirect[k] = a * dot(l.axisA, direct.axis[k]) + b * dot(l.axisB, direct.axis[k]);
         yIndirect[k] = dot(bounceDir, indirect.axis[k]);
     }
     u[0] = 2.f * fromUnorm16(lens[0]) - 1.f;

@@ -141,6 +141,13 @@ struct MaafOptions {
     // Outer components in the direct light's (shadow x lens) filter as well as the indirect
     // light's; without them the direct filter is the central, axis-aligned one everywhere.
     bool shadowComponents = true;
+    // Shadow components only where the shadow slopes on the pixel's surface along its row and
+    // column, maxRadius pixels each way, span at most this factor (max / min); 0: everywhere (the
+    // paper's pipeline). The outer components reproduce one occluder's sheared profile; where the
+    // filter's reach holds occluders at other slopes (grids-shadows' two layers of bars, the
+    // bunny's contact shadow) they measured as bias (docs/maaf.md, "Shadow components where the
+    // slopes agree").
+    float shadowSpan = 0.f;
     // Whether the direct light is filtered by MAAF at all. Without (AAF's pipeline, which filters
     // it with AAF's filter when it has no outer components) its effect is central-only everywhere
     // and carries no widths: nothing reads them (computing them took 0.005-0.011 s of a
@@ -218,10 +225,24 @@ struct MaafParams {
 };
 
 /// Components for every pixel, effect and axis. The result refers to fb, wedges, frames and
-/// view, which must outlive it. With `region`, the indirect effect's stored widths only there
-/// (MaafEffect), whose frames are then all `frames.indirect` needs.
+/// view, which must outlive it. With `region`, both effects' stored widths only there
+/// (MaafEffect), whose frames are then all `frames` needs.
+/// `shadowAgree` (shadowSlopesAgree; null: everywhere): where the direct effect may have outer
+/// components.
 MaafParams maafParams(const FrameBuffers& fb, const WedgeField& wedges, const FilterFrames& frames,
-                      const ViewGeometry& view, const MaafOptions& options, const Image<uint8_t>* region = nullptr);
+                      const ViewGeometry& view, const MaafOptions& options, const Image<uint8_t>* region = nullptr,
+                      const Image<uint8_t>* shadowAgree = nullptr);
+
+/// 1 where the shadow slopes of pixel p and of the pixels on its surface along its row and
+/// column, within o.maxRadius, span at most o.shadowSpan (MaafOptions::shadowSpan); 0 where p
+/// has no shadow wedge.
+Image<uint8_t> shadowSlopesAgree(const FrameBuffers& fb, const WedgeField& wedges, const MaafOptions& options);
+
+/// 1 where maafParams' direct effect has outer components on either axis, decided pixel by
+/// pixel with the pixel's own direct frame (filter::directFrame), without the frames image or
+/// the effect (as maafIndirectOuter for the indirect light).
+Image<uint8_t> maafDirectOuter(const FrameBuffers& fb, const WedgeField& wedges, const ViewGeometry& view,
+                               const MaafOptions& options, const Image<uint8_t>* shadowAgree);
 
 /// 1 where maafParams' indirect effect has outer components on either axis (pairs() > 1),
 /// decided from the pixel's wedge and its frame's steps alone, without the components, the
@@ -274,6 +295,22 @@ private:
     LargeVector<float> m_data;
 };
 
+/// Where a receiver's unoccluded irradiance from light `l` is centred on the light: the mean
+/// light point weighted by cos(receiver) cos(light) / r^2, relative to the light's centre along
+/// its axes A and B (8 x 8 midpoints over each part, uniform in area). The direct light's
+/// accumulation is a ratio, the visibility weighted by each sample's unoccluded light over the
+/// unoccluded light (eq. 23 with value V and weight L), so the light profile its components
+/// reconstruct is the light's density times that weight, not the light's uniform density that
+/// the weights mu_p and the phases C_y y take it to be. A light seen obliquely is brighter on its
+/// near side, and that profile's centroid lies off the light's centre: measured from the centre,
+/// every outer component's phase C_y y carries C_y y0 = s C_x y0, a shift of the reconstructed
+/// shadow by s y0 away from the light (the central component has no phase and does not move).
+/// Measured on a plank's 5.6-px penumbra under a 0.8-wide light 2.5 to the side (docs/maaf.md,
+/// "The direct light's effective centre"): the outer components' shadow 0.18 px off, this
+/// centroid predicting 0.24 px. A flatland penumbra under a uniform, unweighted light
+/// (analysis/penumbra.h) has no such shift, which is one reason the renders disagreed with it.
+Vec2f lightIrradianceCentre(const ViewGeometry::Light& l, const Vec3f& p, const Vec3f& n);
+
 /// A sample as MAAF's accumulation reads it: 36 bytes instead of the 64 of a SampleRecord. The
 /// samples of pixels with outer components are kept in this form until the pixel is accumulated
 /// (render/method_maaf.cpp: the initial ones of every pixel, or those pixels' traced again).
@@ -294,8 +331,10 @@ struct MaafSample {
     /// What the accumulation needs: the light point relative to the light's centre along the
     /// direct frame's axes, the bounce direction along the indirect frame's, and the lens
     /// position along both (lens y is along camera up, axis 2 is image down, hence its sign).
+    /// `lightCentre`: the origin of the light's coordinates, relative to its centre along axes A
+    /// and B (lightIrradianceCentre: where the receiver's unoccluded light is centred).
     void coordinates(const ViewGeometry& view, const AxisFrame& direct, const AxisFrame& indirect, float yDirect[2],
-                     float yIndirect[2], float u[2]) const;
+                     float yIndirect[2], float u[2], Vec2f lightCentre = {0.f, 0.f}) const;
     float visibility() const { return (visible & 1) ? 1.f : 0.f; }
 };
 static_assert(sizeof(MaafSample) == 36 && std::is_trivially_default_constructible_v<MaafSample>);

@@ -11,6 +11,7 @@
 // components (by default only the indirect light's has them; with --maaf-paper-rates eq. 21
 // everywhere, for direct and indirect light), multiplied by albedo; last, the defocus filter of
 // the composited radiance (filter/defocus.h).
+#include <cstdlib>
 #include <algorithm>
 #include <atomic>
 #include <cmath>
@@ -58,14 +59,18 @@ void renderMaaf(const MethodContext& ctx, RenderResult& result) {
     mo.focalFallback = ctx.options.maafFocalFallback;
     mo.maxRadius = ctx.options.maafRadius;
     mo.fitComponents = ctx.options.maafFit;
-    // By default (AAF's pipeline, below) the direct light's filter has no outer components, only
-    // the indirect light's: on the six scenes at 256x256 against 1024-spp references they changed
-    // relMSE by -1.5% (cornell-sphere) to +7% (bunny) and +23% (grids-shadows, whose two layers of
-    // bars put two slopes in the filter's reach), and on a 2.8-px plank penumbra at AAF's
-    // adaptive rates by +61% (their bias, about 4e-5 there, stays while AAF's extra samples halve
-    // its variance); at equal samples without adaptive ones they win there (docs/maaf.md,
-    // "Shadow components").
-    mo.shadowComponents = ctx.options.maafPaperRates;
+    // Outer components in the direct light's (shadow) filter: in the paper's pipeline everywhere;
+    // in AAF's pipeline (the default) only with --maaf-shadow-components, and then only where
+    // the shadow slopes within the filter's reach span at most 1.5x (shadowSpan). Measured at
+    // AAF's rates against 1024-spp references (docs/maaf.md, "Shadow components where the slopes
+    // agree"): on an isolated 2-3 px plank penumbra they cut relMSE to 0.34-0.64x AAF's (once
+    // their light coordinates are measured from where the receiver's light is centred,
+    // filter::lightIrradianceCentre; before, 0.95-1.0x); on the six scenes at 256x256 -0.2% to
+    // 0%, but at 512x512 grids-shadows +2.6% / +3.1% (seeds 2 / 1: the post's contact shadow),
+    // so they are not the default. Without the span rule the six scenes at 256x256 measured
+    // -1.5% (cornell-sphere) to +7% (bunny) and +19-23% (grids-shadows).
+    mo.shadowComponents = ctx.options.maafPaperRates || ctx.options.maafShadowComponents;
+    mo.shadowSpan = ctx.options.maafPaperRates ? 0.f : 1.5f;
     // Indirect outer components only where the nearest bounce hit is at least 5 pixel sizes away
     // (half the clamp). Measured against 1024-spp references (relMSE against AAF's, seeds 1 and 2
     // at 256x256; docs/maaf.md, "Outer components near contacts"), every pixel / half the clamp /
@@ -81,15 +86,18 @@ void renderMaaf(const MethodContext& ctx, RenderResult& result) {
     if (mo.pairs < 1 || mo.pairs > filter::kMaafMaxPairs)
         throw Error("--maaf-components", "expected 1, 3, 5 or 7 components");
 
-    // Without indirect light and with the shadow filter's outer components off (the default),
-    // no pixel can have outer components, and MAAF's pipeline below is AAF's pixel for pixel
-    // (the same image: checked on grids-shadows and on conference without its bounce), only
-    // slower by its components and second frames (grids-shadows at 512x512: 0.88x AAF's
-    // efficiency). So it is AAF's render, with MAAF's statistics saying that nothing was outer.
-    if (!ctx.options.maafPaperRates && !mo.shadowComponents && !mo.apertureWindows && !ctx.scene.desc().render.indirect) {
+    // Without indirect light and without shadow components (--no-maaf-shadow-components, or
+    // several lights or a sphere light, whose direct filter is central), no pixel can have outer
+    // components, and MAAF's pipeline below is AAF's pixel for pixel (the same image: checked on
+    // grids-shadows and on conference without its bounce), only slower by its components and
+    // second frames (grids-shadows at 512x512: 0.88x AAF's efficiency). So it is AAF's render,
+    // with MAAF's statistics saying that nothing was outer.
+    const bool onePlanarLight = view.lights.size() == 1 && !view.lights.front().sphere;
+    if (!ctx.options.maafPaperRates && (!mo.shadowComponents || !onePlanarLight) && !mo.apertureWindows &&
+        !ctx.scene.desc().render.indirect) {
         renderAaf(ctx, result);
         for (const char* key : {"maaf_accumulator_bytes_bound", "maaf_initial_record_bytes", "maaf_sample_record_bytes",
-                                "maaf_accumulator_bytes", "maaf_outer_component_pixels"})
+                                "maaf_accumulator_bytes", "maaf_outer_component_pixels", "maaf_shadow_outer_pixels"})
             result.extra.emplace_back(key, 0.0);
         result.extra.emplace_back("maaf_components", double(2 * mo.pairs - 1));
         result.extra.emplace_back("maaf_retrace", ctx.options.maafKeepRecords ? 0.0 : 1.0);
@@ -185,27 +193,42 @@ void renderMaaf(const MethodContext& ctx, RenderResult& result) {
     // slopes, its central filter everywhere and adaptive samples only at the focal plane (Sec. 6.2).
     const bool paper = ctx.options.maafPaperRates;
     const filter::WedgeField wedges = filter::prefilterWedges(fb, paper ? wo : filter::aafWedgeOptions());
-    // Sparse (the default in AAF's pipeline): only the indirect light can have outer components,
-    // and MAAF's filter reads the indirect light's frames, components and accumulations only
-    // within its window (maxRadius) of the pixels that have them, so those are decided first
-    // (filter::maafIndirectOuter: from the wedge and the frame's steps) and the rest is computed
-    // only in that region. Without any such pixel the render is AAF's. MAAF's prefilter time
-    // over AAF's at 512x512, medians of 12 rounds: cornell 0.23 -> 0.07 s, conference 0.14 ->
-    // 0.08 s, the same image bytes (docs/maaf.md, "Sparse components"; --maaf-dense: before).
-    const bool sparse = ctx.options.maafSparse && !paper && !mo.directEffect && !mo.apertureWindows && ctx.options.aovDir.empty();
-    Image<uint8_t> outerMask, region;
-    size_t outerCount = 0;
+    // Where the direct light's filter may have outer components: where the shadow slopes within
+    // its reach agree (MaafOptions::shadowSpan; AAF's pipeline).
+    Image<uint8_t> agree;
+    if (mo.directEffect && mo.shadowSpan > 0) agree = filter::shadowSlopesAgree(fb, wedges, mo);
+    const Image<uint8_t>* agreeMask = agree.empty() ? nullptr : &agree;
+    // Sparse (the default in AAF's pipeline): MAAF's filter reads the frames, components and
+    // accumulations only within its window (maxRadius) of the pixels with outer components, so
+    // those are decided first, per effect (filter::maafIndirectOuter, maafDirectOuter: from the
+    // wedge and the pixel's own frame) and the rest is computed only in that region. Without any
+    // such pixel the render is AAF's. MAAF's prefilter time over AAF's at 512x512, medians of 12
+    // rounds: cornell 0.23 -> 0.07 s, conference 0.14 -> 0.08 s, the same image bytes
+    // (docs/maaf.md, "Sparse components"; --maaf-dense: every pixel's).
+    const bool sparse = ctx.options.maafSparse && !paper && !mo.apertureWindows && ctx.options.aovDir.empty();
+    Image<uint8_t> outerDirect, outerIndirect, outerMask, region;
+    size_t outerCount = 0, directCount = 0, indirectCount = 0;
+    filter::MaafOptions moParams = mo;
     if (sparse) {
-        outerMask = filter::maafIndirectOuter(fb, wedges, view, mo);
-        for (size_t i = 0; i < pixels; ++i) outerCount += outerMask[i];
+        outerIndirect = filter::maafIndirectOuter(fb, wedges, view, mo);
+        outerDirect = mo.directEffect ? filter::maafDirectOuter(fb, wedges, view, mo, agreeMask) : Image<uint8_t>(W, H);
+        outerMask = Image<uint8_t>(W, H);
+        for (size_t i = 0; i < pixels; ++i) {
+            outerMask[i] = outerDirect[i] | outerIndirect[i];
+            directCount += outerDirect[i];
+            indirectCount += outerIndirect[i];
+            outerCount += outerMask[i];
+        }
         region = filter::dilateBox(outerMask, mo.maxRadius);
+        // No direct outer components anywhere: the direct light is AAF's, with no frames or widths.
+        if (directCount == 0) moParams.directEffect = false;
     }
     const Image<uint8_t>* where = sparse ? &region : nullptr;
     filter::FilterFrames frames;
     if (!sparse || outerCount > 0)
-        frames = filter::computeFrames(fb, view, mo.directEffect, where);  // (the direct light's only if MAAF filters it)
+        frames = filter::computeFrames(fb, view, moParams.directEffect, where);  // (the direct light's only if MAAF filters it)
     filter::MaafParams params = !sparse || outerCount > 0
-                                    ? filter::maafParams(fb, wedges, frames, view, mo, where)
+                                    ? filter::maafParams(fb, wedges, frames, view, moParams, where, agreeMask)
                                     : filter::MaafParams{filter::MaafEffect(W, H), filter::MaafEffect(W, H), Image1f()};
     const filter::AafOptions ao;
     const filter::AafParams rates = filter::aafParams(fb, wedges, view, ao);
@@ -308,7 +331,8 @@ void renderMaaf(const MethodContext& ctx, RenderResult& result) {
     // An effect without outer components anywhere is AAF's alone (by default; below).
     std::optional<filter::MaafAccumulator> accDirect, accIndirect;
     if (sparse) {
-        if (outerCount > 0) accIndirect.emplace(params.indirect, mo.pairs, 3, &region);
+        if (directCount > 0) accDirect.emplace(params.direct, mo.pairs, 1, &region);
+        if (indirectCount > 0) accIndirect.emplace(params.indirect, mo.pairs, 3, &region);
     } else {
         if (paper || anyOuter(params.direct)) accDirect.emplace(params.direct, mo.pairs, 1);
         if (paper || anyOuter(params.indirect)) accIndirect.emplace(params.indirect, mo.pairs, 3);
@@ -316,8 +340,10 @@ void renderMaaf(const MethodContext& ctx, RenderResult& result) {
     result.extra.emplace_back("maaf_accumulator_bytes", double((accDirect ? accDirect->allocatedBytes() : 0) +
                                                                (accIndirect ? accIndirect->allocatedBytes() : 0)));
     std::atomic<uint64_t> outerPixels{0};  // pixels whose accumulation has outer components
+    std::atomic<uint64_t> shadowOuterPixels{0};  // those whose direct light's filter has them
     if (accDirect || accIndirect) parallelRows(H, [&](int y) {
-        uint64_t outerInRow = 0;
+        uint64_t outerInRow = 0, shadowOuterInRow = 0;
+        std::vector<Vec2f> centres;
         for (int x = 0; x < W; ++x) {
             size_t p = size_t(y) * W + x;
             if (sparse && !region[p]) continue;  // no storage: the filter does not read it
@@ -335,15 +361,26 @@ void renderMaaf(const MethodContext& ctx, RenderResult& result) {
                 continue;
             }
             ++outerInRow;
+            if (accDirect && outerComponents(params.direct, p)) ++shadowOuterInRow;
             const filter::MaafPixel direct = params.direct.pixel(p), indirect = params.indirect.pixel(p);
             // (Without the direct light's frames its coordinates are not used: no accDirect.)
             const filter::AxisFrame &frameIndirect = frames.indirect[p],
                                     &frameDirect = frames.direct.size() > 0 ? frames.direct[p] : frameIndirect;
             uint32_t counted = 0;
+            // The direct light's coordinates from where the pixel's unoccluded light is centred
+            // on each light (filter::lightIrradianceCentre), computed for the lights its samples
+            // chose.
+            centres.assign(accDirect ? view.lights.size() : 0, {kInf, kInf});
             auto accumulate = [&](const filter::MaafSample& m) {
                 if (m.slot != primary) return;
                 float yDirect[2], yIndirect[2], u[2];
-                m.coordinates(view, frameDirect, frameIndirect, yDirect, yIndirect, u);
+                Vec2f centre{0.f, 0.f};
+                if (accDirect && ctx.options.maafLightCentre) {
+                    Vec2f& c = centres[m.light];
+                    if (c.x == kInf) c = filter::lightIrradianceCentre(view.lights[m.light], fb.position[p], fb.normal[p]);
+                    centre = c;
+                }
+                m.coordinates(view, frameDirect, frameIndirect, yDirect, yIndirect, u, centre);
                 const float visibility = m.visibility();
                 if (accDirect) accDirect->add(p, &visibility, m.unoccluded, yDirect, u, direct);
                 if (accIndirect) accIndirect->add(p, m.indirect, 1.f, yIndirect, u, indirect);
@@ -358,6 +395,7 @@ void renderMaaf(const MethodContext& ctx, RenderResult& result) {
             }
         }
         outerPixels += outerInRow;
+        shadowOuterPixels += shadowOuterInRow;
     });
     // Free what the filter no longer needs before it allocates its buffers: a lower peak and
     // fewer freshly touched pages.
@@ -365,6 +403,7 @@ void renderMaaf(const MethodContext& ctx, RenderResult& result) {
     LargeVector<filter::MaafSample>().swap(records);
     stats = PixelStatsImage();
     result.extra.emplace_back("maaf_outer_component_pixels", double(outerPixels));
+    result.extra.emplace_back("maaf_shadow_outer_pixels", double(shadowOuterPixels));
     result.seconds.add("prefilter_accumulation", t.seconds());
     result.seconds.add("prefilter",
                        result.seconds.get("prefilter_slopes") + result.seconds.get("prefilter_accumulation"));
@@ -385,20 +424,20 @@ void renderMaaf(const MethodContext& ctx, RenderResult& result) {
         // bandwidths), then MAAF's eq. 21 in the pixels whose effect has outer components.
         const filter::FilterFrames aafFrames = filter::computeFrames(fb, view);
         auto maafWhereOuter = [&](const std::optional<filter::MaafAccumulator>& acc, const filter::MaafEffect& effect,
-                                  const Image<filter::AxisFrame>& axes, Image3f aaf) {
+                                  const Image<filter::AxisFrame>& axes, Image3f aaf, const Image<uint8_t>& outerHere) {
             if (!acc) return aaf;
-            if (sparse) return acc->filter(effect, fb, axes, aaf, mo, &outerMask);
+            if (sparse) return acc->filter(effect, fb, axes, aaf, mo, &outerHere);
             Image<uint8_t> where(W, H);
             for (size_t i = 0; i < pixels; ++i) where[i] = outerComponents(effect, i);
             return acc->filter(effect, fb, axes, aaf, mo, &where);
         };
         visibility = maafWhereOuter(
             accDirect, params.direct, frames.direct,
-            filter::aafFilter(visibilityImage(fb), rates.omegaDirect, fb, aafFrames.direct, ao, &fb.unoccluded));
+            filter::aafFilter(visibilityImage(fb), rates.omegaDirect, fb, aafFrames.direct, ao, &fb.unoccluded), outerDirect);
         result.seconds.add("filter_direct", part.seconds());
         part.reset();
         indirect = maafWhereOuter(accIndirect, params.indirect, frames.indirect,
-                                  filter::aafFilter(fb.indirect, rates.omegaIndirect, fb, aafFrames.indirect, ao));
+                                  filter::aafFilter(fb.indirect, rates.omegaIndirect, fb, aafFrames.indirect, ao), outerIndirect);
         result.seconds.add("filter_indirect", part.seconds());
     }
     part.reset();

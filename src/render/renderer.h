@@ -44,6 +44,14 @@ struct RenderOptions {
     // the filter's window of the pixels with outer components (render/method_maaf.cpp: the same
     // image); false computes them in every pixel (--maaf-dense, for checks).
     bool maafSparse = true;
+    // The direct light's coordinates measured from where each receiver's unoccluded light is
+    // centred on the light (filter::lightIrradianceCentre), not from the light's centre
+    // (--no-maaf-light-centre: before 2026-11-28). Only the direct light's outer components read them.
+    bool maafLightCentre = true;
+    // Outer components in the direct light's filter in AAF's pipeline, where the shadow slopes
+    // within its reach agree (filter::MaafOptions::shadowSpan; --maaf-shadow-components); by
+    // default the indirect light's only. The paper's pipeline has them everywhere.
+    bool maafShadowComponents = false;
     std::string maafWeights = "sampling";  // mu_p: sampling | eq10 | unit (filter/maaf.h, "Weights")
     // à-trous
     int atrousIterations = 5;
