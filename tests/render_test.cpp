@@ -571,6 +571,18 @@ TEST(Render, MaafIsAafWhereNoFilterHasOuterComponents) {
     EXPECT_NE(0, std::memcmp(outer.color.data(), aaf.color.data(), aaf.color.size() * sizeof(Vec3f)));
 }
 
+namespace {
+/// MAAF's render options at `spp` initial samples and `seed`, without progress output.
+render::RenderOptions quietMaaf(int spp, uint32_t seed) {
+    render::RenderOptions o;
+    o.quiet = true;
+    o.method = "maaf";
+    o.spp = spp;
+    o.seed = seed;
+    return o;
+}
+}  // namespace
+
 TEST(Render, MaafSparseComponentsGiveTheDenseImage) {
     // By default MAAF decides first which pixels' indirect filters have outer components
     // (filter::maafIndirectOuter) and computes the frames, components and accumulations only
@@ -582,11 +594,7 @@ TEST(Render, MaafSparseComponentsGiveTheDenseImage) {
     desc.camera.width = desc.camera.height = 96;
     const scene::Scene scene(std::move(desc));
     for (auto [radius, components] : {std::pair{10, 5}, std::pair{16, 5}, std::pair{10, 7}}) {
-        render::RenderOptions o;
-        o.quiet = true;
-        o.method = "maaf";
-        o.spp = 4;
-        o.seed = 9;
+        render::RenderOptions o = quietMaaf(4, 9);
         o.maafRadius = radius;
         o.maafComponents = components;
         const render::RenderResult sparse = render::render(scene, o);
@@ -616,11 +624,7 @@ TEST(Render, MaafSparseShadowComponentsGiveTheDenseImage) {
       "objects": [{"type": "quad", "corner": [-4, 0, 4], "edge1": [8, 0, 0], "edge2": [0, 0, -8], "material": "floor"},
                   {"type": "box", "min": [0.0, 0.2, -2], "max": [0.3, 0.25, 2], "material": "plank"}],
       "render": {"spp": 16, "seed": 1, "indirect": false}})"));
-    render::RenderOptions o;
-    o.quiet = true;
-    o.method = "maaf";
-    o.spp = 8;
-    o.seed = 4;
+    render::RenderOptions o = quietMaaf(8, 4);
     o.maafShadowComponents = true;
     const render::RenderResult sparse = render::render(scene, o);
     o.maafSparse = false;
