@@ -956,7 +956,7 @@ TEST(MaafSample, LightCentreIsWhereTheReceiversUnoccludedLightIsCentred) {
                 sumA += w * (q.x - l.center.x);
                 sumB += w * (q.z - l.center.z);
             }
-        return Vec2f(float(sumA / sum), float(sumB / sum));
+        return Vec2f{float(sumA / sum), float(sumB / sum)};
     };
     const Vec2f above = filter::lightIrradianceCentre(l, l.center - Vec3f(0.f, 3.f, 0.f), up);
     EXPECT_NEAR(above.x, 0.f, 1e-5f);
