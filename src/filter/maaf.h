@@ -145,8 +145,8 @@ struct MaafOptions {
     // column, maxRadius pixels each way, span at most this factor (max / min); 0: everywhere (the
     // paper's pipeline). The outer components reproduce one occluder's sheared profile; where the
     // filter's reach holds occluders at other slopes (grids-shadows' two layers of bars, the
-    // bunny's contact shadow) they measured as bias (docs/maaf.md, "Shadow components where the
-    // slopes agree").
+    // bunny's contact shadow) they measured as bias (docs/maaf.md, "The direct light's effective
+    // centre").
     float shadowSpan = 0.f;
     // Whether the direct light is filtered by MAAF at all. Without (AAF's pipeline, which filters
     // it with AAF's filter when it has no outer components) its effect is central-only everywhere

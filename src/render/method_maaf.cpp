@@ -11,7 +11,6 @@
 // components (by default only the indirect light's has them; with --maaf-paper-rates eq. 21
 // everywhere, for direct and indirect light), multiplied by albedo; last, the defocus filter of
 // the composited radiance (filter/defocus.h).
-#include <cstdlib>
 #include <algorithm>
 #include <atomic>
 #include <cmath>
@@ -62,8 +61,8 @@ void renderMaaf(const MethodContext& ctx, RenderResult& result) {
     // Outer components in the direct light's (shadow) filter: in the paper's pipeline everywhere;
     // in AAF's pipeline (the default) only with --maaf-shadow-components, and then only where
     // the shadow slopes within the filter's reach span at most 1.5x (shadowSpan). Measured at
-    // AAF's rates against 1024-spp references (docs/maaf.md, "Shadow components where the slopes
-    // agree"): on an isolated 2-3 px plank penumbra they cut relMSE to 0.34-0.64x AAF's (once
+    // AAF's rates against 1024-spp references (docs/maaf.md, "The direct light's effective
+    // centre"): on an isolated 2-3 px plank penumbra they cut relMSE to 0.34-0.64x AAF's (once
     // their light coordinates are measured from where the receiver's light is centred,
     // filter::lightIrradianceCentre; before, 0.95-1.0x); on the six scenes at 256x256 -0.2% to
     // 0%, but at 512x512 grids-shadows +2.6% / +3.1% (seeds 2 / 1: the post's contact shadow),
@@ -86,8 +85,8 @@ void renderMaaf(const MethodContext& ctx, RenderResult& result) {
     if (mo.pairs < 1 || mo.pairs > filter::kMaafMaxPairs)
         throw Error("--maaf-components", "expected 1, 3, 5 or 7 components");
 
-    // Without indirect light and without shadow components (--no-maaf-shadow-components, or
-    // several lights or a sphere light, whose direct filter is central), no pixel can have outer
+    // Without indirect light and without shadow components (the default, or several lights or a
+    // sphere light, whose direct filter is central), no pixel can have outer
     // components, and MAAF's pipeline below is AAF's pixel for pixel (the same image: checked on
     // grids-shadows and on conference without its bounce), only slower by its components and
     // second frames (grids-shadows at 512x512: 0.88x AAF's efficiency). So it is AAF's render,
