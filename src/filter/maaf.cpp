@@ -210,14 +210,6 @@ bool indirectInputs(const WedgeField& wf, const AxisFrame& frame, float object, 
     return true;
 }
 
-/// The light whose spectrum weighs the direct light's outer components: the only one the
-/// filters see (a lamp of many coplanar triangles is one, scene::lightGroups), if it is planar
-/// (a sphere's samples have no one plane to take y in: its direct filter is central, as with
-/// several).
-const ViewGeometry::Light* singlePlanarLight(const ViewGeometry& view) {
-    return view.lights.size() == 1 && !view.lights.front().sphere ? &view.lights.front() : nullptr;
-}
-
 /// The direct light's inputs of pixel p's axis k: the shadow wedge in the light plane.
 /// The outer components reproduce the sheared profile of one light (their weights are its
 /// spectrum, their y its coordinates): with several lights (groups), whose samples share a
@@ -245,6 +237,10 @@ bool directInputs(const WedgeField& wf, const AxisFrame& frame, float object, bo
 }
 
 }  // namespace
+
+const ViewGeometry::Light* singlePlanarLight(const ViewGeometry& view) {
+    return view.lights.size() == 1 && !view.lights.front().sphere ? &view.lights.front() : nullptr;
+}
 
 Image<uint8_t> shadowSlopesAgree(const FrameBuffers& fb, const WedgeField& wf, const MaafOptions& o) {
     const int W = fb.width, H = fb.height;
@@ -373,13 +369,10 @@ MaafParams maafParams(const FrameBuffers& fb, const WedgeField& wf, const Filter
         Image1f object, footprint, fallback;
     };
     auto snap = std::make_shared<Snapshot>(Snapshot{fb.object, fb.footprint, fallback});
-    // Direct: the shadow wedge in the light plane (directInputs). The agreement mask is shared:
-    // the effect computes a pixel's axes again when they are asked for (MaafEffect::pixel).
-    std::shared_ptr<const Image<uint8_t>> agree;
-    if (shadowAgree) agree = std::make_shared<const Image<uint8_t>>(*shadowAgree);
-    auto direct = [&, snap, lens, single, agree, o](size_t p, int k, MaafAxis& out) {
+    // Direct: the shadow wedge in the light plane (directInputs).
+    auto direct = [&, snap, lens, single, shadowAgree, o](size_t p, int k, MaafAxis& out) {
         AxisInputs in;
-        if (!directInputs(wf, frames.direct[p], snap->object[p], snap->fallback[p] > 0, lens, single, agree.get(), p, k, o,
+        if (!directInputs(wf, frames.direct[p], snap->object[p], snap->fallback[p] > 0, lens, single, shadowAgree, p, k, o,
                           in)) {
             out = MaafAxis{};
             out.pairs = 1;

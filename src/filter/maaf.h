@@ -224,14 +224,20 @@ struct MaafParams {
     Image1f fallback;  // 1 where the pixel uses the central component only (focal plane)
 };
 
-/// Components for every pixel, effect and axis. The result refers to fb, wedges, frames and
-/// view, which must outlive it. With `region`, both effects' stored widths only there
-/// (MaafEffect), whose frames are then all `frames` needs.
-/// `shadowAgree` (shadowSlopesAgree; null: everywhere): where the direct effect may have outer
-/// components.
+/// Components for every pixel, effect and axis. The result refers to fb, wedges, frames, view
+/// and shadowAgree, which must outlive it (MaafEffect computes a pixel's axes again when they
+/// are asked for). With `region`, both effects' stored widths only there (MaafEffect), whose
+/// frames are then all `frames` needs. `shadowAgree` (shadowSlopesAgree; null: everywhere):
+/// where the direct effect may have outer components.
 MaafParams maafParams(const FrameBuffers& fb, const WedgeField& wedges, const FilterFrames& frames,
                       const ViewGeometry& view, const MaafOptions& options, const Image<uint8_t>* region = nullptr,
                       const Image<uint8_t>* shadowAgree = nullptr);
+
+/// The light whose spectrum weighs the direct light's outer components: the only one the
+/// filters see (a lamp of many coplanar triangles is one, scene::lightGroups), if it is planar
+/// (a sphere's samples have no one plane to take y in: its direct filter is central, as with
+/// several); null otherwise.
+const ViewGeometry::Light* singlePlanarLight(const ViewGeometry& view);
 
 /// 1 where the shadow slopes of pixel p and of the pixels on its surface along its row and
 /// column, within o.maxRadius, span at most o.shadowSpan (MaafOptions::shadowSpan); 0 where p

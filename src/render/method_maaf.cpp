@@ -91,8 +91,7 @@ void renderMaaf(const MethodContext& ctx, RenderResult& result) {
     // grids-shadows and on conference without its bounce), only slower by its components and
     // second frames (grids-shadows at 512x512: 0.88x AAF's efficiency). So it is AAF's render,
     // with MAAF's statistics saying that nothing was outer.
-    const bool onePlanarLight = view.lights.size() == 1 && !view.lights.front().sphere;
-    if (!ctx.options.maafPaperRates && (!mo.shadowComponents || !onePlanarLight) && !mo.apertureWindows &&
+    if (!ctx.options.maafPaperRates && (!mo.shadowComponents || !filter::singlePlanarLight(view)) && !mo.apertureWindows &&
         !ctx.scene.desc().render.indirect) {
         renderAaf(ctx, result);
         for (const char* key : {"maaf_accumulator_bytes_bound", "maaf_initial_record_bytes", "maaf_sample_record_bytes",
