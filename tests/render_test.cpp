@@ -355,6 +355,56 @@ TEST(Render, ImageIsBitIdenticalOnOneAndTwoThreads) {
     }
 }
 
+TEST(Render, TextureSamplesChangeOnlyTexturedPixelsAndNotWithTheThreads) {
+    // kPlaneScene checkered (cells 2.5 px wide): the filters whose colour is albedo x filtered
+    // light take texture samples where a pixel's samples saw the albedo vary. The same image
+    // on one and two threads; without texture samples the pixels whose samples saw one albedo
+    // are the same bytes (only the albedo changed: the filtered light did not), and the others
+    // differ. Without a texture no pixel takes them (the same image as --texture-spp 0).
+    std::string json = kPlaneScene;
+    const std::string plain = R"("grey": {"albedo": [0.5, 0.6, 0.7]})";
+    json.replace(json.find(plain), plain.size(), R"("grey": {"albedo": [0.5, 0.6, 0.7], "texture": "checker", "texture_scale": 8})");
+    for (const char* method : {"aaf", "maaf", "atrous"}) {
+        render::RenderOptions o;
+        o.quiet = true;
+        o.method = method;
+        o.spp = 16;
+        o.layers = "off";
+        scene::Scene s(parse(json));
+        render::RenderResult r1, r2, none;
+        {
+            ThreadLimit one(1);
+            r1 = render::render(s, o);
+        }
+        {
+            ThreadLimit two(2);
+            r2 = render::render(s, o);
+        }
+        EXPECT_EQ(0, std::memcmp(r1.color.data(), r2.color.data(), r1.color.size() * sizeof(Vec3f))) << method;
+        const double textured = r1.figure("texture_pixels").value_or(-1);
+        EXPECT_GT(textured, 0.2 * r1.color.size()) << method;
+        EXPECT_LT(textured, 0.9 * r1.color.size()) << method;
+        o.textureSpp = 0;
+        none = render::render(s, o);
+        EXPECT_EQ(none.figure("texture_pixels").value_or(-1), 0.0) << method;
+        int changed = 0;
+        for (size_t i = 0; i < r1.color.size(); ++i) {
+            if (r1.buffers.albedo[i] == none.buffers.albedo[i])
+                EXPECT_EQ(r1.color[i], none.color[i]) << method << " pixel " << i;
+            else
+                ++changed;
+        }
+        EXPECT_NEAR(changed, textured, 0.02 * textured) << method;  // (a pixel's texture samples may all agree with it)
+        scene::Scene untextured(parse(kPlaneScene));
+        o.textureSpp = 64;
+        const render::RenderResult a = render::render(untextured, o);
+        o.textureSpp = 0;
+        const render::RenderResult b = render::render(untextured, o);
+        EXPECT_EQ(a.figure("texture_pixels").value_or(-1), 0.0) << method;
+        EXPECT_EQ(0, std::memcmp(a.color.data(), b.color.data(), a.color.size() * sizeof(Vec3f))) << method;
+    }
+}
+
 TEST(Render, ALampOfTrianglesIsOneLightForTheFilters) {
     // kPlaneScene's light as the fan of four triangles about its centre: the filters see one
     // light (ViewGeometry::lights), with the whole light's centroid, size and parts, and every
@@ -716,6 +766,54 @@ TEST(Render, PixelStatsTakeFurtherSlotsOnlyForASecondSurface) {
     EXPECT_EQ(moved(0, 0).slot(1).object, 5u);
     EXPECT_EQ(moved(0, 0).primary(), 0);
     EXPECT_EQ(moved(1, 1).primary(), 1);
+}
+
+TEST(Render, TextureSamplesJoinTheAlbedoOfTheSurfacesThePixelSaw) {
+    // A pixel on one surface whose samples saw two albedos (a checker's edge): its albedo
+    // varies, a texture sample on that surface joins the stored mean albedo, one on a surface
+    // the pixel's path samples never saw (or a miss) does not; the light stays demodulated
+    // by the path samples' own albedo. An untextured surface has no albedo variance.
+    ViewGeometry view;
+    view.width = view.height = 1;
+    view.focalPixels = 100;
+    render::SlotPool pool;
+    render::PixelStats edge, plain;
+    for (int i = 0; i < 4; ++i) {
+        render::TracedSample s = surfaceSample(0, 1.f);
+        s.albedo = Vec3f(i < 2 ? 0.8f : 0.2f);  // half light, half dark cells
+        edge.add(s, view, false, pool);
+        plain.add(surfaceSample(0, 1.f), view, false, pool);
+    }
+    EXPECT_EQ(plain.albedoVariance(), 0.f);
+    // Luminance 0.8 and 0.2 equally: mean 0.5, variance 0.09, relative 0.36.
+    EXPECT_NEAR(edge.albedoVariance(), 0.36f, 1e-5f);
+    render::TracedSample dark = surfaceSample(0, 0.f);
+    dark.albedo = Vec3f(0.2f);
+    for (int i = 0; i < 4; ++i) EXPECT_TRUE(edge.addPrimary(dark));
+    EXPECT_FALSE(edge.addPrimary(surfaceSample(7, 0.f)));  // another surface
+    EXPECT_FALSE(edge.addPrimary(render::TracedSample()));  // a miss
+    FrameBuffers fb(1, 1);
+    edge.store(fb, 0, 0, view);
+    EXPECT_NEAR(fb.albedo[0].x, (2 * 0.8f + 2 * 0.2f + 4 * 0.2f) / 8.f, 1e-6f);  // 0.35
+    // Demodulated by the path samples' mean albedo (0.5): their mean of albedo x light is 0.5.
+    EXPECT_NEAR(fb.direct[0].x, 1.f, 1e-6f);
+    EXPECT_EQ(fb.spp[0], 4.f);  // texture samples are not path samples
+    // The miss counts towards the pixel's coverage (4 + 4 of 4 + 5 samples on the surface).
+    EXPECT_NEAR(fb.coverage[0], 8.f / 9.f, 1e-6f);
+    // A silhouette's pixel: two path samples on the surface, two that hit nothing. Primary
+    // samples refine the surface's share of the pixel: four on it and eight misses make it
+    // (2 + 4) / (4 + 12) = 0.375 of the surface-or-nothing share (all of it here); one on a
+    // surface the path samples did not see counts for neither.
+    render::PixelStats rim;
+    for (int i = 0; i < 4; ++i) rim.add(i < 2 ? surfaceSample(0, 1.f) : render::TracedSample(), view, false, pool);
+    EXPECT_TRUE(rim.mixed());
+    EXPECT_FALSE(plain.mixed());
+    for (int i = 0; i < 4; ++i) EXPECT_TRUE(rim.addPrimary(surfaceSample(0, 0.f)));
+    for (int i = 0; i < 8; ++i) EXPECT_FALSE(rim.addPrimary(render::TracedSample()));
+    EXPECT_FALSE(rim.addPrimary(surfaceSample(7, 0.f)));
+    rim.store(fb, 0, 0, view);
+    EXPECT_NEAR(fb.coverage[0], 6.f / 16.f, 1e-6f);
+    EXPECT_NEAR(fb.albedo[0].x, 1.f, 1e-6f);
 }
 
 TEST(Render, APixelKeepsItsFirstSurfacesApartAndTheRestAsColour) {

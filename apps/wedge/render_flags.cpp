@@ -38,6 +38,10 @@ void addRenderFlags(CLI::App& cmd, RenderFlags& flags) {
 void addMethodFlags(CLI::App& cmd, render::RenderOptions& r) {
     cmd.add_option("--max-extra-spp", r.maxExtraSpp, "aaf/maaf: cap on adaptive samples per pixel (default 16; the papers use 100)")
         ->check(numberIn(0, 1 << 16));
+    cmd.add_option("--texture-spp", r.textureSpp,
+                   "aaf/maaf/atrous: camera rays alone per pixel for the albedo where a pixel's samples saw a texture "
+                   "(default 64; 0: none; not with --layers)")
+        ->check(numberIn(0, 1 << 16));
     cmd.add_option("--maaf-components", r.maafComponents, "maaf: filters per 2D/3D subspace (3, 5 or 7; 1: the central, axis-aligned filter alone)")
         ->check(CLI::IsMember({1, 3, 5, 7}));
     cmd.add_flag("--maaf-paper-rates", r.maafPaperRates,

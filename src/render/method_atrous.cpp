@@ -8,7 +8,7 @@
 namespace wedge::render {
 
 void renderAtrous(const MethodContext& ctx, RenderResult& result) {
-    sampleUniform(ctx, "atrous sampling", result);
+    sampleUniform(ctx, "atrous sampling", result, true);
     filter::AtrousParams params;
     params.iterations = ctx.options.atrousIterations;
     params.sigmaColor = ctx.options.atrousSigmaColor;

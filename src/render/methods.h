@@ -60,10 +60,24 @@ constexpr float kMixedTau = 0.01f;
 constexpr uint32_t kMixedSpp = 64;
 
 
+/// Texture samples, in every method that multiplies filtered light by albedo (aaf, maaf, atrous)
+/// when it composes per pixel (no light field): where a pixel's path samples saw the albedo of a
+/// surface vary by more than kTextureVariance (PixelStats::albedoVariance), options.textureSpp
+/// primary hits more (PathSampler::primaryHits: a camera ray each, no light, no bounce), whose
+/// albedo joins that of the surface they land on (PixelStats::addTexture). No filter reaches a
+/// texture's noise: a pixel's colour is its surface's filtered light times the mean albedo its
+/// camera rays saw, and 16-32 of them leave a checker's pixels noisy (docs/textures.md). Takes
+/// the pixels' sample indices on from their path samples' (the same seed, the same image on any
+/// number of threads or ranks). Returns the rays traced; the pixels' count in `pixels`.
+uint64_t textureSamples(const MethodContext& ctx, PixelStatsImage& stats, uint64_t* pixels = nullptr);
+/// The relative variance of a surface's albedo luminance above which a pixel takes texture samples.
+constexpr float kTextureVariance = 1e-4f;
+
 /// Monte Carlo sampling as `mc` does it: ctx.spp samples per pixel, then the emitter-edge
 /// top-up, into pixel statistics of its own. Adds the rays to result.rays, fills result.buffers,
 /// and times "sampling" (the statistics' allocation included).
-void sampleUniform(const MethodContext& ctx, const std::string& label, RenderResult& result);
+/// With `texture`, texture samples (textureSamples) before the statistics are stored.
+void sampleUniform(const MethodContext& ctx, const std::string& label, RenderResult& result, bool texture = false);
 
 /// Stores every pixel's statistics into `fb`, with the closed-form unoccluded direct light.
 void storeStats(const PixelStatsImage& stats, const MethodContext& ctx, FrameBuffers& fb);

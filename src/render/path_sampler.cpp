@@ -404,4 +404,34 @@ Vec3f PathSampler::meanEmission(int x, int y, uint32_t count) const {
     return count > 0 ? sum / float(count) : sum;
 }
 
+uint64_t PathSampler::primaryHits(int x, int y, uint32_t first, uint32_t count, TracedSample* out) const {
+    constexpr int K = scene::RayPacket::kSize;
+    const PixelSampler rng(m_seed, uint32_t(y) * uint32_t(m_camera.width()) + uint32_t(x));
+    for (uint32_t done = 0; done < count; done += K) {
+        const int n = int(std::min<uint32_t>(K, count - done));
+        scene::RayPacket primary;
+        Vec2f lens[K];
+        float choice[K], time[K];
+        cameraRays(rng, x, y, first + done, n, primary, lens, choice, time, nullptr);
+        scene::Hit hit[K];
+        bool found[K] = {};
+        m_scene.intersect(primary, hit, found);
+        for (int k = 0; k < n; ++k) {
+            TracedSample& o = out[done + k];
+            o = TracedSample();
+            o.rays = 1;
+            if (!found[k]) continue;
+            // As traceMany takes them, so that a texture sample finds the slot of its surface.
+            const Vec3f geometric = dot(hit[k].normal, primary.dir[k]) < 0 ? hit[k].normal : -hit[k].normal;
+            o.hit = true;
+            o.albedo = hit[k].albedo;
+            o.normal = facing(hit[k].shadingNormal, geometric);
+            o.position = hit[k].position;
+            o.depth = m_camera.depth(hit[k].position);
+            o.object = hit[k].object;
+        }
+    }
+    return count;
+}
+
 }  // namespace wedge::render

@@ -78,6 +78,11 @@ public:
     /// see: the emitted part of those path samples, from their primary rays alone (no light
     /// sample, no bounce), at a fraction of their cost.
     Vec3f meanEmission(int x, int y, uint32_t count) const;
+    /// The primary hits of samples first .. first+count-1 of pixel (x, y), from their camera rays
+    /// alone (no light sample, no bounce): each out[k] has the fields PixelStats::slotOf and the
+    /// albedo read (hit, object, normal, position, depth, albedo; rays = 1), the rest default.
+    /// What the texture samples are made of (PixelStats::addTexture). Returns the rays traced.
+    uint64_t primaryHits(int x, int y, uint32_t first, uint32_t count, TracedSample* out) const;
 
     const Camera& camera() const { return m_camera; }
     uint32_t seed() const { return m_seed; }

@@ -12,6 +12,7 @@ void SurfaceSlot::add(const TracedSample& s, const ViewGeometry& view, bool slop
     ++n;
     const SampleRecord& r = s.record;
     albedo += s.albedo;
+    albedoSq += sqr(luminance(s.albedo));
     rhoDirect += s.albedo * r.direct;
     rhoIndirect += s.albedo * r.indirect;
     direct += r.direct;
@@ -63,7 +64,10 @@ int PixelStats::add(const TracedSample& s, const ViewGeometry& view, bool slopes
         suHi = std::max(suHi, su);
         suAbsMin = std::min(suAbsMin, std::abs(su));
     }
-    if (!s.hit) return -1;
+    if (!s.hit) {
+        ++nMiss;
+        return -1;
+    }
     if (first.n == 0 || first.matches(s)) {
         first.add(s, view, slopes);
         return 0;
@@ -104,6 +108,16 @@ void PixelStats::store(FrameBuffers& fb, int x, int y, const ViewGeometry& view)
         for (int c = 0; c < 3; ++c) out[c] = s.albedo[c] > 1e-6f ? rho[c] / s.albedo[c] : plain[c] / float(s.n);
         return out;
     };
+    // Coverage: with primary samples (addPrimary), each surface's share of the samples that
+    // landed on the pixel's surfaces or on nothing, over path and primary samples together,
+    // scaled by the path samples' share of those (the rest, surfaces beyond the slots, keeps
+    // its own). Without them the path samples' share.
+    uint32_t slotsN = nMiss, primaryN = primaryMiss;
+    for (int k = 0; k < kSlots; ++k) {
+        slotsN += slot(k).n;
+        primaryN += slot(k).textureN;
+    }
+    const float coverageScale = primaryN > 0 ? float(slotsN) * invN / float(slotsN + primaryN) : 0.f;
     // The planes every kept surface has (the primary's in fb, the others' in fb.other).
     auto storeSurface = [&](const SurfaceSlot& s, Image3f& albedo, Image3f& direct, Image3f& indirect, Image3f& normal,
                             Image3f& position, Image1f& object, Image1f& coverage) {
@@ -114,8 +128,10 @@ void PixelStats::store(FrameBuffers& fb, int x, int y, const ViewGeometry& view)
             return;
         }
         const float inv = 1.f / float(s.n);
-        coverage[p] = float(s.n) * invN;
-        albedo[p] = s.albedo * inv;
+        coverage[p] = primaryN > 0 ? float(s.n + s.textureN) * coverageScale : float(s.n) * invN;
+        // The path samples' albedo with the texture samples' (PixelStats::addTexture); the
+        // light stays demodulated by the path samples' own (above), a ratio estimator.
+        albedo[p] = s.textureN == 0 ? s.albedo * inv : (s.albedo + s.textureAlbedo) / float(s.n + s.textureN);
         direct[p] = demodulate(s, s.rhoDirect, s.direct);
         indirect[p] = demodulate(s, s.rhoIndirect, s.indirect);
         normal[p] = normalize(s.normal);

@@ -43,6 +43,19 @@ struct SurfaceSlot {
     float lightSigma = kInf;            // smallest ViewGeometry::Light::sigma of the occluded samples' lights
     float zMin = kInf, zMax = 0;        // bounce hit distances
     float suMin = kInf, suMax = -kInf;  // defocus slopes
+    // Texture: the sum of the samples' squared albedo luminance, and the primary-only samples'
+    // albedo (PixelStats::addTexture), which the stored albedo averages in.
+    float albedoSq = 0;
+    Vec3f textureAlbedo{0.f};
+    uint32_t textureN = 0;
+
+    /// The relative variance of the albedo's luminance over this surface's path samples: 0 on
+    /// an untextured surface.
+    float albedoVariance() const {
+        if (n < 2) return 0.f;
+        const float mean = luminance(albedo) / float(n);
+        return mean > 0 ? std::max(0.f, albedoSq / float(n) - mean * mean) / (mean * mean) : 0.f;
+    }
 
     /// Same surface: same object, normal within 20 degrees, and on the first sample's tangent
     /// plane (a box face in front of a parallel wall of the same mesh is another surface).
@@ -73,6 +86,8 @@ struct PixelStats {
     Vec3f color{0.f}, emission{0.f}, light{0.f};  // light: sum of albedo * (direct + indirect)
     float lumSum = 0, lumSq = 0;
     uint32_t n = 0, nEmitter = 0;  // nEmitter: samples that saw an emitter
+    uint32_t nMiss = 0;            // samples that hit nothing (no light: the scene has no environment)
+    uint32_t primaryMiss = 0;      // primary samples (addPrimary) that hit nothing
     float suLo = kInf, suHi = -kInf;  // defocus slopes of every sample added with slopes (all surfaces, misses)
     float suAbsMin = kInf;            // the smallest |defocus slope| among them
     static constexpr int kSlots = 1 + SlotPool::kBlock;
@@ -99,6 +114,30 @@ struct PixelStats {
         for (int k = 0; k < kSlots; ++k)
             if (slot(k).matches(s)) return k;
         return -1;
+    }
+    /// A primary sample (PathSampler::primaryHits: a camera ray alone): its albedo joins its
+    /// surface's, if it is one this pixel's path samples found, and it counts towards the
+    /// coverage of that surface, or of the pixel's misses (store()). False where it goes
+    /// nowhere: a miss, or a surface the path samples did not see (whose light nothing knows).
+    bool addPrimary(const TracedSample& s) {
+        if (!s.hit) {
+            ++primaryMiss;
+            return false;
+        }
+        const int k = slotOf(s);
+        if (k < 0) return false;
+        SurfaceSlot& sl = k == 0 ? first : more[k - 1];
+        sl.textureAlbedo += s.albedo;
+        ++sl.textureN;
+        return true;
+    }
+    /// Whether the samples saw a surface and something else (another surface or nothing).
+    bool mixed() const { return first.n > 0 && first.n < n; }
+    /// The largest albedoVariance() among the pixel's surfaces.
+    float albedoVariance() const {
+        float v = 0;
+        for (int k = 0; k < kSlots; ++k) v = std::max(v, slot(k).albedoVariance());
+        return v;
     }
     /// Extra samples that bring a pixel partly covering an emitter up to `target`: no filter can
     /// reach emitted light, and a bright edge seen by few samples dominates any relative error.

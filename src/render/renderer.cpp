@@ -72,6 +72,32 @@ uint64_t denseEmission(const MethodContext& ctx, const Image<uint32_t>& topUp, F
     return rays;
 }
 
+uint64_t textureSamples(const MethodContext& ctx, PixelStatsImage& stats, uint64_t* pixels) {
+    const uint32_t count = uint32_t(std::max(ctx.options.textureSpp, 0));
+    if (count == 0 || ctx.lightField) {
+        if (pixels) *pixels = 0;
+        return 0;
+    }
+    std::atomic<uint64_t> rays{0}, textured{0};
+    parallelRows(stats.height(), [&](int y) {
+        if (!ctx.sampler.tracesRow(y)) return;
+        std::vector<TracedSample> hits(count);
+        uint64_t localRays = 0, localPixels = 0;
+        for (int x = 0; x < stats.width(); ++x) {
+            PixelStats& ps = stats(x, y);
+            if (ps.albedoVariance() <= kTextureVariance) continue;
+            localRays += ctx.sampler.primaryHits(x, y, ps.n, count, hits.data());
+            for (const TracedSample& h : hits) ps.addPrimary(h);
+            ++localPixels;
+        }
+        rays += localRays;
+        textured += localPixels;
+    });
+    exchangeStats(ctx.sampler.distribution(), stats);
+    if (pixels) *pixels = textured;
+    return rays;
+}
+
 Image3f visibilityImage(const FrameBuffers& fb) {
     Image3f v(fb.width, fb.height);
     for (size_t i = 0; i < v.size(); ++i) v[i] = Vec3f(fb.visibility[i]);
@@ -135,7 +161,7 @@ double averageSpp(const FrameBuffers& fb) {
     return fb.spp.empty() ? 0 : s / double(fb.spp.size());
 }
 
-void sampleUniform(const MethodContext& ctx, const std::string& label, RenderResult& result) {
+void sampleUniform(const MethodContext& ctx, const std::string& label, RenderResult& result, bool texture) {
     const ViewGeometry& view = ctx.view;
     Timer t;  // from the pixel statistics' allocation: first touching them is part of the stage
     PixelStatsImage stats(view.width, view.height);
@@ -152,6 +178,11 @@ void sampleUniform(const MethodContext& ctx, const std::string& label, RenderRes
         ctx.sampler, stats, view,
         [&](int x, int y) { return SampleRange{uint32_t(ctx.spp), topUp(x, y)}; }, false,
         false, [&](int x, int y, const TracedSample& s, int slot) { more.record(x, y, s, slot); }, nullptr);
+    if (texture) {
+        uint64_t texturePixels = 0;
+        result.rays += textureSamples(ctx, stats, &texturePixels);
+        result.extra.emplace_back("texture_pixels", double(texturePixels));
+    }
     storeStats(stats, ctx, result.buffers);
     finishLightField(ctx, stats);
     result.rays += denseEmission(ctx, topUp, result.buffers);

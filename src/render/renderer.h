@@ -27,6 +27,11 @@ struct RenderOptions {
     // (docs/measurements.md, "Adaptive sampling cap"): beyond it the samples cost more time than they remove error.
     static constexpr int kDefaultMaxExtraSpp = 16;
     int maxExtraSpp = kDefaultMaxExtraSpp;
+    // aaf, maaf, atrous (without the layered reconstruction): primary-only samples (camera rays
+    // alone) per pixel where the pixel's path samples saw their surface's albedo vary (a
+    // texture), for the albedo the filtered light is multiplied by (render/methods.h,
+    // textureSamples); 0: none.
+    int textureSpp = 64;
     int maafComponents = 5;          // 2N-1 filters per 2D/3D subspace
     bool maafFocalFallback = true;   // fall back to the central filter where the defocus slope changes sign
     // MAAF's pipeline as the paper has it (--maaf-paper-rates): its slopes, its central filter
