@@ -335,26 +335,39 @@ TEST(MaafQuality, UnoccludedPlaneMatchesClosedForm) {
     }
 }
 
+namespace {
+/// UnoccludedPlaneMatchesClosedForm's plane, checkered with cells 1 / scale wide (32 px span
+/// 1.6 world units), and its 4096-spp reference.
+scene::Scene checkeredPlane(int scale) {
+    const std::string plane = R"({
+      "camera": {"position": [0, 0.8, 0.001], "look_at": [0, 0, 0], "up": [0, 0, -1], "fov_y": 90, "resolution": [32, 32],
+                 "aperture_radius": 0.02, "focus_distance": 0.5},
+      "materials": {"grey": {"albedo": [0.5, 0.6, 0.7], "texture": "checker", "texture_scale": )" + std::to_string(scale) + R"(}},
+      "lights": [{"type": "parallelogram", "corner": [-0.3, 1, -0.5], "edge1": [1, 0, 0], "edge2": [0, 0, 1], "radiance": [10, 10, 10]}],
+      "objects": [{"type": "quad", "corner": [-4, 0, 4], "edge1": [8, 0, 0], "edge2": [0, 0, -8], "material": "grey"}],
+      "render": {"spp": 16, "seed": 3, "indirect": false}
+    })";
+    return scene::Scene(scene::parseScene(plane, "plane.json", "."));
+}
+render::RenderResult checkeredPlaneReference(const scene::Scene& s) {
+    render::RenderOptions o;
+    o.quiet = true;
+    o.spp = 4096;
+    o.seed = 9999;
+    return render::render(s, o);
+}
+}  // namespace
+
 TEST(AafQuality, TextureSamplesTakeTheNoiseOfCellEdges) {
     // The checkered plane of TexturedPlaneKeepsItsCheckerSharp with cells 2.5 px wide: most
     // pixels straddle a cell edge, and there the colour's noise is the mean albedo's, which no
     // filter of light reaches. 64 camera rays alone per such pixel (render/methods.h,
     // textureSamples) take it below half of what it is without them (seeds 5 and 6 together:
     // AAF and MAAF 0.36x, à-trous 0.44x).
-    const char* plane = R"({
-      "camera": {"position": [0, 0.8, 0.001], "look_at": [0, 0, 0], "up": [0, 0, -1], "fov_y": 90, "resolution": [32, 32],
-                 "aperture_radius": 0.02, "focus_distance": 0.5},
-      "materials": {"grey": {"albedo": [0.5, 0.6, 0.7], "texture": "checker", "texture_scale": 8}},
-      "lights": [{"type": "parallelogram", "corner": [-0.3, 1, -0.5], "edge1": [1, 0, 0], "edge2": [0, 0, 1], "radiance": [10, 10, 10]}],
-      "objects": [{"type": "quad", "corner": [-4, 0, 4], "edge1": [8, 0, 0], "edge2": [0, 0, -8], "material": "grey"}],
-      "render": {"spp": 16, "seed": 3, "indirect": false}
-    })";
-    scene::Scene s(scene::parseScene(plane, "plane.json", "."));
+    const scene::Scene s = checkeredPlane(8);
+    const render::RenderResult ref = checkeredPlaneReference(s);
     render::RenderOptions o;
     o.quiet = true;
-    o.spp = 4096;
-    o.seed = 9999;
-    const render::RenderResult ref = render::render(s, o);
     for (const char* method : {"aaf", "maaf", "atrous"}) {
         o.method = method;
         o.spp = 16;
@@ -377,20 +390,10 @@ TEST(MaafQuality, TexturedPlaneKeepsItsCheckerSharp) {
     // texture, since they filter it demodulated and multiply the pixel's own mean albedo back.
     // Pixels inside a cell (all 4096 reference samples on it) match the reference within 2%,
     // dark cells (1/5 of the albedo) as well as light ones.
-    const char* plane = R"({
-      "camera": {"position": [0, 0.8, 0.001], "look_at": [0, 0, 0], "up": [0, 0, -1], "fov_y": 90, "resolution": [32, 32],
-                 "aperture_radius": 0.02, "focus_distance": 0.5},
-      "materials": {"grey": {"albedo": [0.5, 0.6, 0.7], "texture": "checker", "texture_scale": 2}},
-      "lights": [{"type": "parallelogram", "corner": [-0.3, 1, -0.5], "edge1": [1, 0, 0], "edge2": [0, 0, 1], "radiance": [10, 10, 10]}],
-      "objects": [{"type": "quad", "corner": [-4, 0, 4], "edge1": [8, 0, 0], "edge2": [0, 0, -8], "material": "grey"}],
-      "render": {"spp": 16, "seed": 3, "indirect": false}
-    })";
-    scene::Scene s(scene::parseScene(plane, "plane.json", "."));
+    const scene::Scene s = checkeredPlane(2);
+    const render::RenderResult ref = checkeredPlaneReference(s);
     render::RenderOptions o;
     o.quiet = true;
-    o.spp = 4096;
-    o.seed = 9999;
-    const render::RenderResult ref = render::render(s, o);
     int light = 0, dark = 0;
     for (const char* method : {"maaf", "aaf"}) {
         o.method = method;
