@@ -60,9 +60,7 @@ void renderAaf(const MethodContext& ctx, RenderResult& result) {
             ctx.sampler, stats, view, [&](int x, int y) { return SampleRange{n0, extra(x, y)}; }, false, false,
             [&](int x, int y, const TracedSample& s, int slot) { record.record(x, y, s, slot); }, &progress);
     }
-    uint64_t texturePixels = 0;
-    result.rays += textureSamples(ctx, stats, &texturePixels);
-    result.extra.emplace_back("texture_pixels", double(texturePixels));
+    textureSamples(ctx, stats, result);
     storeStats(stats, ctx, fb);
     finishLightField(ctx, stats);
     result.rays += denseEmission(ctx, emitterExtra, fb);

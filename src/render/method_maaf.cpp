@@ -285,9 +285,7 @@ void renderMaaf(const MethodContext& ctx, RenderResult& result) {
             },
             &progress);
     }
-    uint64_t texturePixels = 0;
-    result.rays += textureSamples(ctx, stats, &texturePixels);
-    result.extra.emplace_back("texture_pixels", double(texturePixels));
+    textureSamples(ctx, stats, result);
     storeStats(stats, ctx, fb);
     finishLightField(ctx, stats);
     result.rays += denseEmission(ctx, emitterExtra, fb);

@@ -129,7 +129,7 @@ void PixelStats::store(FrameBuffers& fb, int x, int y, const ViewGeometry& view)
         }
         const float inv = 1.f / float(s.n);
         coverage[p] = primaryN > 0 ? float(s.n + s.textureN) * coverageScale : float(s.n) * invN;
-        // The path samples' albedo with the texture samples' (PixelStats::addTexture); the
+        // The path samples' albedo with the texture samples' (PixelStats::addPrimary); the
         // light stays demodulated by the path samples' own (above), a ratio estimator.
         albedo[p] = s.textureN == 0 ? s.albedo * inv : (s.albedo + s.textureAlbedo) / float(s.n + s.textureN);
         direct[p] = demodulate(s, s.rhoDirect, s.direct);

@@ -43,8 +43,9 @@ struct SurfaceSlot {
     float lightSigma = kInf;            // smallest ViewGeometry::Light::sigma of the occluded samples' lights
     float zMin = kInf, zMax = 0;        // bounce hit distances
     float suMin = kInf, suMax = -kInf;  // defocus slopes
-    // Texture: the sum of the samples' squared albedo luminance, and the primary-only samples'
-    // albedo (PixelStats::addTexture), which the stored albedo averages in.
+    // Texture: the sum of the samples' squared albedo luminance, and the albedo and count of the
+    // primary-only samples on this surface (PixelStats::addPrimary), which the stored albedo and
+    // coverage take in.
     float albedoSq = 0;
     Vec3f textureAlbedo{0.f};
     uint32_t textureN = 0;

@@ -72,11 +72,11 @@ uint64_t denseEmission(const MethodContext& ctx, const Image<uint32_t>& topUp, F
     return rays;
 }
 
-uint64_t textureSamples(const MethodContext& ctx, PixelStatsImage& stats, uint64_t* pixels) {
+void textureSamples(const MethodContext& ctx, PixelStatsImage& stats, RenderResult& result) {
     const uint32_t count = uint32_t(std::max(ctx.options.textureSpp, 0));
     if (count == 0 || ctx.lightField) {
-        if (pixels) *pixels = 0;
-        return 0;
+        result.extra.emplace_back("texture_pixels", 0.0);
+        return;
     }
     std::atomic<uint64_t> rays{0}, textured{0};
     parallelRows(stats.height(), [&](int y) {
@@ -94,8 +94,8 @@ uint64_t textureSamples(const MethodContext& ctx, PixelStatsImage& stats, uint64
         textured += localPixels;
     });
     exchangeStats(ctx.sampler.distribution(), stats);
-    if (pixels) *pixels = textured;
-    return rays;
+    result.rays += rays;
+    result.extra.emplace_back("texture_pixels", double(textured));
 }
 
 Image3f visibilityImage(const FrameBuffers& fb) {
@@ -178,11 +178,7 @@ void sampleUniform(const MethodContext& ctx, const std::string& label, RenderRes
         ctx.sampler, stats, view,
         [&](int x, int y) { return SampleRange{uint32_t(ctx.spp), topUp(x, y)}; }, false,
         false, [&](int x, int y, const TracedSample& s, int slot) { more.record(x, y, s, slot); }, nullptr);
-    if (texture) {
-        uint64_t texturePixels = 0;
-        result.rays += textureSamples(ctx, stats, &texturePixels);
-        result.extra.emplace_back("texture_pixels", double(texturePixels));
-    }
+    if (texture) textureSamples(ctx, stats, result);
     storeStats(stats, ctx, result.buffers);
     finishLightField(ctx, stats);
     result.rays += denseEmission(ctx, topUp, result.buffers);
