@@ -405,46 +405,28 @@ TEST(Render, TextureSamplesChangeOnlyTexturedPixelsAndNotWithTheThreads) {
     }
 }
 
-TEST(Render, TextureSamplesJoinTheLightFieldAndNotWithTheThreads) {
-    // kPlankUnderLens with a checkered floor, --layers on: the texture samples go into the light
-    // field as samples of their own (24 bytes each, one stage more), the same image on one and
-    // two threads; the plain plank takes none and keeps its bytes.
+TEST(Render, TextureSamplesStayOutOfTheLightField) {
+    // kPlankUnderLens with a checkered floor, --layers on: every sample carries its own albedo
+    // into the light field, and texture samples recorded there cost more than they gained on
+    // held-out scenes (docs/textures.md), so none is taken: the image is --texture-spp 0's.
     std::string json = kPlankUnderLens;
     const std::string plain = R"("grey": {"albedo": [0.6, 0.6, 0.6]})";
     json.replace(json.find(plain), plain.size(), R"("grey": {"albedo": [0.6, 0.6, 0.6], "texture": "checker", "texture_scale": 8})");
-    const scene::Scene textured(parse(json)), untextured(parse(kPlankUnderLens));
-    for (const char* method : {"aaf", "maaf", "atrous"}) {
+    const scene::Scene textured(parse(json));
+    for (const char* method : {"aaf", "atrous"}) {
         render::RenderOptions o;
         o.quiet = true;
         o.method = method;
         o.spp = 16;
         o.layers = "on";
-        render::RenderResult r1, r2;
-        {
-            ThreadLimit one(1);
-            r1 = render::render(textured, o);
-        }
-        {
-            ThreadLimit two(2);
-            r2 = render::render(textured, o);
-        }
-        EXPECT_EQ(0, std::memcmp(r1.color.data(), r2.color.data(), r1.color.size() * sizeof(Vec3f))) << method;
-        const double pixels = double(r1.color.size());
-        const double tp = r1.figure("texture_pixels").value_or(-1);
-        EXPECT_GT(tp, 0.1 * pixels) << method;
+        const render::RenderResult with = render::render(textured, o);
         o.textureSpp = 0;
-        const render::RenderResult none = render::render(textured, o);
-        EXPECT_EQ(r1.figure("layers_sample_bytes").value_or(0) - none.figure("layers_sample_bytes").value_or(0),
-                  24.0 * 64.0 * tp + 8.0 * (pixels + 1.0))
-            << method;
-        EXPECT_NE(0, std::memcmp(r1.color.data(), none.color.data(), r1.color.size() * sizeof(Vec3f))) << method;
-        for (size_t i = 0; i < r1.color.size(); ++i) EXPECT_TRUE(isFinite(r1.color[i])) << method << " pixel " << i;
-        const render::RenderResult a = render::render(untextured, o);
+        const render::RenderResult without = render::render(textured, o);
+        EXPECT_EQ(with.figure("texture_pixels").value_or(-1), 0.0) << method;
+        EXPECT_EQ(0, std::memcmp(with.color.data(), without.color.data(), with.color.size() * sizeof(Vec3f))) << method;
+        o.layers = "off";  // (the same floor, composed per pixel, takes them)
         o.textureSpp = 64;
-        const render::RenderResult b = render::render(untextured, o);
-        EXPECT_EQ(b.figure("texture_pixels").value_or(-1), 0.0) << method;
-        EXPECT_EQ(a.figure("layers_sample_bytes"), b.figure("layers_sample_bytes")) << method;
-        EXPECT_EQ(0, std::memcmp(a.color.data(), b.color.data(), a.color.size() * sizeof(Vec3f))) << method;
+        EXPECT_GT(render::render(textured, o).figure("texture_pixels").value_or(0), 0.0) << method;
     }
 }
 
@@ -832,12 +814,9 @@ TEST(Render, TextureSamplesJoinTheAlbedoOfTheSurfacesThePixelSaw) {
     EXPECT_NEAR(edge.albedoVariance(), 0.36f, 1e-5f);
     render::TracedSample dark = surfaceSample(0, 0.f);
     dark.albedo = Vec3f(0.2f);
-    for (int i = 0; i < 4; ++i) EXPECT_EQ(edge.addPrimary(dark), 0);  // its slot
-    EXPECT_EQ(edge.addPrimary(surfaceSample(7, 0.f)), -1);  // another surface
-    EXPECT_EQ(edge.addPrimary(render::TracedSample()), -1);  // a miss
-    // The light a texture sample carries into the light field: the surface's demodulated
-    // light (the path samples' mean of albedo x light, 0.5, over their mean albedo, 0.5).
-    EXPECT_NEAR(edge.slot(0).light().x, 1.f, 1e-6f);
+    for (int i = 0; i < 4; ++i) EXPECT_TRUE(edge.addPrimary(dark));
+    EXPECT_FALSE(edge.addPrimary(surfaceSample(7, 0.f)));  // another surface
+    EXPECT_FALSE(edge.addPrimary(render::TracedSample()));  // a miss
     FrameBuffers fb(1, 1);
     edge.store(fb, 0, 0, view);
     EXPECT_NEAR(fb.albedo[0].x, (2 * 0.8f + 2 * 0.2f + 4 * 0.2f) / 8.f, 1e-6f);  // 0.35
@@ -854,12 +833,9 @@ TEST(Render, TextureSamplesJoinTheAlbedoOfTheSurfacesThePixelSaw) {
     for (int i = 0; i < 4; ++i) rim.add(i < 2 ? surfaceSample(0, 1.f) : render::TracedSample(), view, false, pool);
     EXPECT_TRUE(rim.mixed());
     EXPECT_FALSE(plain.mixed());
-    for (int i = 0; i < 4; ++i) EXPECT_EQ(rim.addPrimary(surfaceSample(0, 0.f)), 0);
-    for (int i = 0; i < 8; ++i) EXPECT_EQ(rim.addPrimary(render::TracedSample()), -1);
-    EXPECT_EQ(rim.addPrimary(surfaceSample(7, 0.f)), -1);
-    // ... whose light, in the light field, is that of the surface nearest in depth.
-    EXPECT_EQ(rim.nearestSlot(3.f), 0);
-    EXPECT_EQ(render::PixelStats().nearestSlot(1.f), -1);
+    for (int i = 0; i < 4; ++i) EXPECT_TRUE(rim.addPrimary(surfaceSample(0, 0.f)));
+    for (int i = 0; i < 8; ++i) EXPECT_FALSE(rim.addPrimary(render::TracedSample()));
+    EXPECT_FALSE(rim.addPrimary(surfaceSample(7, 0.f)));
     rim.store(fb, 0, 0, view);
     EXPECT_NEAR(fb.coverage[0], 6.f / 16.f, 1e-6f);
     EXPECT_NEAR(fb.albedo[0].x, 1.f, 1e-6f);

@@ -722,8 +722,6 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
     const int W = lf.width(), H = lf.height();
     Image3f out(W, H);
     const ViewGeometry& view = in.view;
-    const bool filtered = std::any_of(in.surfaceLight.begin(), in.surfaceLight.end(), [](const Image3f* l) { return l; });
-    const float radianceSigmaMin = filtered ? std::min(o.sigmaMinFiltered, o.sigmaMin) : o.sigmaMin;
 
     // How far each pixel's samples' trajectories reach (2 |c| + |m| from where they were taken).
     std::vector<float> reach(size_t(W) * H, 0.f);
@@ -882,7 +880,7 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                         // (Not widened by the slopes' spread: the rays follow the slope they find. Half the
                         // spread, as it was, over-blurred the layers a tile's budget had widened: AAF
                         // relMSE on docs/conference-wide.json with a budget of 8 layers 0.000927 -> 0.000667.)
-                        l.sigma = std::clamp(o.sigmaScale * std::abs(l.c), radianceSigmaMin, o.sigmaMax);
+                        l.sigma = std::clamp(o.sigmaScale * std::abs(l.c), o.sigmaMin, o.sigmaMax);
                         // The coverage's Gaussian may be narrower than the radiance's: a Gaussian
                         // of 0.5 px sampled at 1-px cells is aliased, and the edge it gives a
                         // layer just past the sharp threshold depends on where the edge falls

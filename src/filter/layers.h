@@ -26,12 +26,11 @@
 //    shutter time for a moving layer (a moving surface's shading changes as it moves); and the
 //    sum of its samples' slopes. A sample in front of the layer tells nothing about it, so it is
 //    left out of D: alpha = N / D is the layer's coverage where it is not hidden. The grids are
-//    smoothed with a Gaussian of sigma = clamp(0.15 |c_l|, 0.5, 2) pixels (0.35, not 0.5, where
-//    the samples carry filtered light), the coverage's (N, D) and the slopes' with one of
-//    clamp(0.15 |c_l|, 0.25, 2); cells without weight (the layer hidden there) are filled from
-//    their neighbours. A layer whose true blur (a disc of radius |c|, a segment of length |m|)
-//    is below the grid's own with a Gaussian of 0.5 is "sharp": not reprojected, its grid its
-//    pixels' own samples.
+//    smoothed with a Gaussian of sigma = clamp(0.15 |c_l|, 0.5, 2) pixels, the coverage's (N, D)
+//    and the slopes' with one of clamp(0.15 |c_l|, 0.25, 2); cells without weight (the layer
+//    hidden there) are filled from their neighbours. A layer whose true blur (a disc of radius
+//    |c|, a segment of length |m|) is below the grid's own with the radiance's Gaussian is
+//    "sharp": not reprojected, its grid its pixels' own samples.
 // 3. Each pixel is the mean of 32 reconstruction rays (x, y, u, v, t), a 5D Kronecker sequence
 //    shifted per pixel, so that pixel, lens and shutter are stratified jointly. Front to back, a
 //    ray takes each layer's alpha and premultiplied radiance at its shear, with the slope and
@@ -73,12 +72,6 @@ struct LayerOptions {
     int maxReach = 48;         // pixels: a sample's trajectory is followed at most this far (the cost bound)
     float sigmaScale = 0.15f;  // the sharp image's Gaussian: sigmaScale |c_l|, clamped to [sigmaMin, sigmaMax]
     float sigmaMin = 0.5f, sigmaMax = 2.f;
-    // ... but sigmaMinFiltered where the samples carry filtered light (LayerInput::surfaceLight):
-    // its noise is the albedo's alone, and 0.5 over-blurred textures. (AAF with --layers on,
-    // relMSE 0.5 -> 0.35: docs/textured.json -26%, docs/posts.json -9%, conference and
-    // cornell-sphere at 512x512 -3% and -2%, bunny +0.3%; 0.3 and 0.4 within 2% of 0.35; MC,
-    // whose samples carry their own radiance, +5% on posts with 0.35: docs/textures.md.)
-    float sigmaMinFiltered = 0.35f;
     // ... and the coverage's (N, D) and the slopes': sigmaScale |c_l| clamped to [sigmaCoverageMin,
     // the radiance's]. The rays' shear is shaped for it; the sharp threshold stays sigmaMin's.
     // (0.5, as the radiance's, measured MC relMSE higher at 512x512 on conference by 9%, cornell

@@ -60,19 +60,17 @@ constexpr float kMixedTau = 0.01f;
 constexpr uint32_t kMixedSpp = 64;
 
 
-/// Texture samples, in every method that multiplies filtered light by albedo (aaf, maaf, atrous):
-/// where a pixel's path samples saw the albedo of a surface vary by more than kTextureVariance
-/// (PixelStats::albedoVariance), options.textureSpp primary hits more (PathSampler::primaryHits:
-/// a camera ray each, no light, no bounce), whose albedo joins that of the surface they land on
-/// and whose hits refine the surfaces' shares of the pixel (PixelStats::addPrimary). No filter
-/// reaches a texture's noise: a pixel's colour is its surface's filtered light times the mean
-/// albedo its camera rays saw, and 16-32 of them leave a checker's pixels noisy
-/// (docs/textures.md). With ctx.lightField they are also recorded there, as a stage of their
-/// own, each with its albedo and its surface's demodulated light (SurfaceSlot::light), so that
-/// the layered reconstruction counts them as it counts path samples. Takes the pixels' sample
-/// indices on from their path samples' (the same seed, the same image on any number of threads
-/// or ranks). Adds the rays to result.rays and the pixels' count to result.extra
-/// ("texture_pixels").
+/// Texture samples, in every method that multiplies filtered light by albedo (aaf, maaf, atrous)
+/// when it composes per pixel (no light field): where a pixel's path samples saw the albedo of a
+/// surface vary by more than kTextureVariance (PixelStats::albedoVariance), options.textureSpp
+/// primary hits more (PathSampler::primaryHits: a camera ray each, no light, no bounce), whose
+/// albedo joins that of the surface they land on and whose hits refine the surfaces' shares of
+/// the pixel (PixelStats::addPrimary). No filter reaches a
+/// texture's noise: a pixel's colour is its surface's filtered light times the mean albedo its
+/// camera rays saw, and 16-32 of them leave a checker's pixels noisy (docs/textures.md). Takes
+/// the pixels' sample indices on from their path samples' (the same seed, the same image on any
+/// number of threads or ranks). Adds the rays to result.rays and the pixels' count to
+/// result.extra ("texture_pixels").
 void textureSamples(const MethodContext& ctx, PixelStatsImage& stats, RenderResult& result);
 /// The relative variance of a surface's albedo luminance above which a pixel takes texture samples.
 constexpr float kTextureVariance = 1e-4f;

@@ -410,9 +410,9 @@ uint64_t PathSampler::primaryHits(int x, int y, uint32_t first, uint32_t count, 
     for (uint32_t done = 0; done < count; done += K) {
         const int n = int(std::min<uint32_t>(K, count - done));
         scene::RayPacket primary;
-        Vec2f lens[K], film[K];
+        Vec2f lens[K];
         float choice[K], time[K];
-        cameraRays(rng, x, y, first + done, n, primary, lens, choice, time, nullptr, film);
+        cameraRays(rng, x, y, first + done, n, primary, lens, choice, time, nullptr);
         scene::Hit hit[K];
         bool found[K] = {};
         m_scene.intersect(primary, hit, found);
@@ -420,9 +420,6 @@ uint64_t PathSampler::primaryHits(int x, int y, uint32_t first, uint32_t count, 
             TracedSample& o = out[done + k];
             o = TracedSample();
             o.rays = 1;
-            o.record.lens = lens[k];
-            o.film = film[k];
-            o.time = time[k];
             if (!found[k]) continue;
             // As traceMany takes them, so that a texture sample finds the slot of its surface.
             const Vec3f geometric = dot(hit[k].normal, primary.dir[k]) < 0 ? hit[k].normal : -hit[k].normal;
@@ -432,12 +429,6 @@ uint64_t PathSampler::primaryHits(int x, int y, uint32_t first, uint32_t count, 
             o.position = hit[k].position;
             o.depth = m_camera.depth(hit[k].position);
             o.object = hit[k].object;
-            if (lengthSquared(hit[k].displacement) > 0) {  // as traceMany: the hit's path on the screen
-                const Vec3f& d = hit[k].displacement;
-                const Vec2f open = m_camera.project(hit[k].position - d * time[k]);
-                const Vec2f close = m_camera.project(hit[k].position + d * (1.f - time[k]));
-                o.motion = {close.x - open.x, close.y - open.y};
-            }
         }
     }
     return count;

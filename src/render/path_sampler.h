@@ -80,8 +80,7 @@ public:
     Vec3f meanEmission(int x, int y, uint32_t count) const;
     /// The primary hits of samples first .. first+count-1 of pixel (x, y), from their camera rays
     /// alone (no light sample, no bounce): each out[k] has the fields PixelStats::slotOf and the
-    /// albedo read (hit, object, normal, position, depth, albedo; rays = 1) and its light-field
-    /// coordinates (film, record.lens, time, motion), the rest default.
+    /// albedo read (hit, object, normal, position, depth, albedo; rays = 1), the rest default.
     /// What the texture samples are made of (PixelStats::addPrimary). Returns the rays traced.
     uint64_t primaryHits(int x, int y, uint32_t first, uint32_t count, TracedSample* out) const;
 

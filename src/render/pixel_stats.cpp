@@ -102,6 +102,12 @@ void PixelStats::store(FrameBuffers& fb, int x, int y, const ViewGeometry& view)
     Vec3f slotLight(0.f);
     for (int k = 0; k < kSlots; ++k) slotLight += slot(k).rhoDirect + slot(k).rhoIndirect;
     fb.rest[p] = (light - slotLight) * invN;
+    // Demodulate so that albedo * direct reproduces a slot's mean of albedo_s * direct_s.
+    auto demodulate = [](const SurfaceSlot& s, const Vec3f& rho, const Vec3f& plain) {
+        Vec3f out;
+        for (int c = 0; c < 3; ++c) out[c] = s.albedo[c] > 1e-6f ? rho[c] / s.albedo[c] : plain[c] / float(s.n);
+        return out;
+    };
     // Coverage: with primary samples (addPrimary), each surface's share of the samples that
     // landed on the pixel's surfaces or on nothing, over path and primary samples together,
     // scaled by the path samples' share of those (the rest, surfaces beyond the slots, keeps
@@ -124,11 +130,10 @@ void PixelStats::store(FrameBuffers& fb, int x, int y, const ViewGeometry& view)
         const float inv = 1.f / float(s.n);
         coverage[p] = primaryN > 0 ? float(s.n + s.textureN) * coverageScale : float(s.n) * invN;
         // The path samples' albedo with the texture samples' (PixelStats::addPrimary); the
-        // light stays demodulated by the path samples' own (SurfaceSlot::demodulate), a ratio
-        // estimator.
+        // light stays demodulated by the path samples' own (above), a ratio estimator.
         albedo[p] = s.textureN == 0 ? s.albedo * inv : (s.albedo + s.textureAlbedo) / float(s.n + s.textureN);
-        direct[p] = s.demodulate(s.rhoDirect, s.direct);
-        indirect[p] = s.demodulate(s.rhoIndirect, s.indirect);
+        direct[p] = demodulate(s, s.rhoDirect, s.direct);
+        indirect[p] = demodulate(s, s.rhoIndirect, s.indirect);
         normal[p] = normalize(s.normal);
         position[p] = s.position * inv;
         object[p] = float(s.object);

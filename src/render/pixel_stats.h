@@ -58,16 +58,6 @@ struct SurfaceSlot {
         return mean > 0 ? std::max(0.f, albedoSq / float(n) - mean * mean) / (mean * mean) : 0.f;
     }
 
-    /// Demodulated light, so that albedo * it reproduces the mean of albedo_s * light_s over the
-    /// samples (per channel; where the albedo is 0, the plain mean of light_s).
-    Vec3f demodulate(const Vec3f& rho, const Vec3f& plain) const {
-        Vec3f out;
-        for (int c = 0; c < 3; ++c) out[c] = albedo[c] > 1e-6f ? rho[c] / albedo[c] : plain[c] / float(n);
-        return out;
-    }
-    /// The demodulated direct and indirect light together (n > 0).
-    Vec3f light() const { return demodulate(rhoDirect, direct) + demodulate(rhoIndirect, indirect); }
-
     /// Same surface: same object, normal within 20 degrees, and on the first sample's tangent
     /// plane (a box face in front of a parallel wall of the same mesh is another surface).
     bool matches(const TracedSample& s) const {
@@ -128,32 +118,19 @@ struct PixelStats {
     }
     /// A primary sample (PathSampler::primaryHits: a camera ray alone): its albedo joins its
     /// surface's, if it is one this pixel's path samples found, and it counts towards the
-    /// coverage of that surface, or of the pixel's misses (store()). Returns its slot, or -1
-    /// where it goes nowhere: a miss, or a surface the path samples did not see (whose light
-    /// nothing knows).
-    int addPrimary(const TracedSample& s) {
+    /// coverage of that surface, or of the pixel's misses (store()). False where it goes
+    /// nowhere: a miss, or a surface the path samples did not see (whose light nothing knows).
+    bool addPrimary(const TracedSample& s) {
         if (!s.hit) {
             ++primaryMiss;
-            return -1;
+            return false;
         }
         const int k = slotOf(s);
-        if (k < 0) return -1;
+        if (k < 0) return false;
         SurfaceSlot& sl = k == 0 ? first : more[k - 1];
         sl.textureAlbedo += s.albedo;
         ++sl.textureN;
-        return k;
-    }
-    /// The slot whose mean depth is nearest `depth`, or -1 where no slot has a sample.
-    int nearestSlot(float depth) const {
-        int best = -1;
-        float bestD = kInf;
-        for (int k = 0; k < kSlots; ++k) {
-            const SurfaceSlot& sl = slot(k);
-            if (sl.n == 0) continue;
-            const float d = std::abs(sl.depth / float(sl.n) - depth);
-            if (d < bestD) best = k, bestD = d;
-        }
-        return best;
+        return true;
     }
     /// Whether the samples saw a surface and something else (another surface or nothing).
     bool mixed() const { return first.n > 0 && first.n < n; }

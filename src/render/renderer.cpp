@@ -74,53 +74,28 @@ uint64_t denseEmission(const MethodContext& ctx, const Image<uint32_t>& topUp, F
 
 void textureSamples(const MethodContext& ctx, PixelStatsImage& stats, RenderResult& result) {
     const uint32_t count = uint32_t(std::max(ctx.options.textureSpp, 0));
-    if (count == 0) {
+    if (count == 0 || ctx.lightField) {
         result.extra.emplace_back("texture_pixels", 0.0);
         return;
     }
-    const int W = stats.width();
-    auto textured = [](const PixelStats& ps) { return ps.albedoVariance() > kTextureVariance; };
-    // Which pixels take them is known on every rank (the statistics were exchanged): the light
-    // field's stage has the same runs everywhere. An untextured image adds no stage.
-    std::atomic<bool> any{false};
-    parallelRows(stats.height(), [&](int y) {
-        for (int x = 0; x < W && !any.load(std::memory_order_relaxed); ++x)
-            if (textured(stats(x, y))) any = true;
-    });
-    if (!any) {
-        result.extra.emplace_back("texture_pixels", 0.0);
-        return;
-    }
-    LightFieldStage record(ctx.lightField, [&](size_t p) { return textured(stats(int(p % W), int(p / W))) ? count : 0u; });
-    std::atomic<uint64_t> rays{0}, texturedPixels{0};
+    std::atomic<uint64_t> rays{0}, textured{0};
     parallelRows(stats.height(), [&](int y) {
         if (!ctx.sampler.tracesRow(y)) return;
         std::vector<TracedSample> hits(count);
         uint64_t localRays = 0, localPixels = 0;
-        for (int x = 0; x < W; ++x) {
+        for (int x = 0; x < stats.width(); ++x) {
             PixelStats& ps = stats(x, y);
-            if (!textured(ps)) continue;
+            if (ps.albedoVariance() <= kTextureVariance) continue;
             localRays += ctx.sampler.primaryHits(x, y, ps.n, count, hits.data());
-            for (TracedSample& h : hits) {
-                const int slot = ps.addPrimary(h);
-                if (!ctx.lightField) continue;
-                // Into the light field, carrying its surface's light as the pixel's path samples
-                // measured it (SurfaceSlot::light: the layered reconstruction takes it where a
-                // sample carries its own light) and its own albedo. A hit on a surface those
-                // samples did not see takes the light of the one nearest in depth: dropping it
-                // would leave its layer's coverage short.
-                const int k = slot >= 0 || !h.hit ? slot : ps.nearestSlot(h.depth);
-                h.record.direct = k >= 0 ? ps.slot(k).light() : Vec3f(0.f);
-                record.record(x, y, h, k);
-            }
+            for (const TracedSample& h : hits) ps.addPrimary(h);
             ++localPixels;
         }
         rays += localRays;
-        texturedPixels += localPixels;
+        textured += localPixels;
     });
     exchangeStats(ctx.sampler.distribution(), stats);
     result.rays += rays;
-    result.extra.emplace_back("texture_pixels", double(texturedPixels));
+    result.extra.emplace_back("texture_pixels", double(textured));
 }
 
 Image3f visibilityImage(const FrameBuffers& fb) {
