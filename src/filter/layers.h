@@ -14,8 +14,9 @@
 // surface collapse there onto a sharp image, so samples of many pixels can be reused.
 //
 // Per screen tile (64 pixels, with an apron as wide as the trajectories that reach it):
-// 1. The samples are split into depth layers: moving and still samples apart, each sorted by
-//    defocus slope (which falls with depth); a new layer starts where the slopes spread more than
+// 1. The samples are split into depth layers: still samples and up to three groups of moving
+//    ones of like motion apart (layers.cpp, kMotionGroups), each sorted by defocus slope (which
+//    falls with depth); a new layer starts where the slopes spread more than
 //    max(0.5, 0.15 |c|) pixels or jump by half a pixel; consecutive still layers that are each
 //    sharp (below) are one, which composites exactly as they would (at most 16 layers, the
 //    thresholds widened until they fit). Layers are composited in the order of their mean
