@@ -799,11 +799,13 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                 Gathered* next = g.data();
                 // The slopes of each class, kept in registers while the samples are read (as
                 // range[cls].add(c) they went through memory, a store and a load per sample on
-                // the gather's critical path), and the motion groups' first motions.
+                // the gather's critical path), and the motion groups' first motions and squared
+                // tolerances.
                 float lo[kClasses], hi[kClasses];
                 std::fill(lo, lo + kClasses, kInf);
                 std::fill(hi, hi + kClasses, -kInf);
                 Vec2f group[kMotionGroups];
+                float groupTol2[kMotionGroups];
                 int groups = 0;
                 // The motion group of a moving sample (kMotionGroups).
                 auto groupOf = [&](float mx, float my) {
@@ -811,12 +813,12 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                     float best = kInf;
                     for (int k = 0; k < groups; ++k) {
                         const float d2 = sqr(mx - group[k].x) + sqr(my - group[k].y);
-                        const float tol = std::max(kMotionTolerance, kMotionToleranceRel * std::sqrt(sqr(group[k].x) + sqr(group[k].y)));
-                        if (d2 <= tol * tol) return k;
+                        if (d2 <= groupTol2[k]) return k;
                         if (d2 < best) best = d2, nearest = k;
                     }
                     if (groups < kMotionGroups) {
                         group[groups] = {mx, my};
+                        groupTol2[groups] = sqr(std::max(kMotionTolerance, kMotionToleranceRel * std::sqrt(mx * mx + my * my)));
                         return groups++;
                     }
                     return nearest;

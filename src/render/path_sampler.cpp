@@ -140,6 +140,15 @@ TracedSample PathSampler::trace(int x, int y, uint32_t index, bool span) const {
     return out;
 }
 
+void PathSampler::setPrimaryHit(TracedSample& o, const scene::Hit& hit, const Vec3f& geometric) const {
+    o.hit = true;
+    o.albedo = hit.albedo;
+    o.normal = facing(hit.shadingNormal, geometric);
+    o.position = hit.position;
+    o.depth = m_camera.depth(hit.position);
+    o.object = hit.object;
+}
+
 void PathSampler::cameraRays(const PixelSampler& rng, int x, int y, uint32_t first, int n, scene::RayPacket& primary,
                              Vec2f* lens, float* choice, float* time, Vec2f* uLight, Vec2f* film) const {
     constexpr int K = scene::RayPacket::kSize;
@@ -280,14 +289,9 @@ void PathSampler::traceMany(const SampleRun* runs, size_t nRuns, bool span) cons
                 const scene::Material& mat = m_scene.material(hit.material);
                 const bool front = dot(hit.normal, primary.dir[k]) < 0;
                 w.geometric[l] = front ? hit.normal : -hit.normal;  // two-sided shading
-                w.normal[l] = facing(hit.shadingNormal, w.geometric[l]);
                 TracedSample& o = out[k];
-                o.hit = true;
-                o.albedo = hit.albedo;
-                o.normal = w.normal[l];
-                o.position = hit.position;
-                o.depth = m_camera.depth(hit.position);
-                o.object = hit.object;
+                setPrimaryHit(o, hit, w.geometric[l]);
+                w.normal[l] = o.normal;
                 if (lengthSquared(hit.displacement) > 0) {
                     // The hit point's path over the shutter, through the lens centre.
                     const Vec3f& d = hit.displacement;
@@ -422,13 +426,7 @@ uint64_t PathSampler::primaryHits(int x, int y, uint32_t first, uint32_t count, 
             o.rays = 1;
             if (!found[k]) continue;
             // As traceMany takes them, so that a texture sample finds the slot of its surface.
-            const Vec3f geometric = dot(hit[k].normal, primary.dir[k]) < 0 ? hit[k].normal : -hit[k].normal;
-            o.hit = true;
-            o.albedo = hit[k].albedo;
-            o.normal = facing(hit[k].shadingNormal, geometric);
-            o.position = hit[k].position;
-            o.depth = m_camera.depth(hit[k].position);
-            o.object = hit[k].object;
+            setPrimaryHit(o, hit[k], dot(hit[k].normal, primary.dir[k]) < 0 ? hit[k].normal : -hit[k].normal);
         }
     }
     return count;
