@@ -11,7 +11,9 @@ jittered over the pixel, sheared by the shaped disc (kDiscShape at rho = sqrt(gr
 the same table and lerp as layers.cpp) and looked up bilinearly between cell centres. Against it
 the thin lens's truth: the share of a pixel's (position, lens point) pairs that see the plane.
 A layer below the grid's own blur (|c| < 2 sqrt(kCellBlur + 0.25), 1.41 px) is sharp: each pixel
-its own samples, which is exact (no sharing) at any slope.
+its own samples, which is exact (no sharing) at any slope. Below it, the second table runs the
+near-focus slopes that Monte Carlo's samples share at 16 spp (LayerOptions::sharpShare 0.5: a
+layer is sharp only below |c| = 1.0 px).
 
 It prints, per floor and slope, the mean over 8 edge positions (E = 48 + k / 8) of the squared coverage
 error summed over the pixels of the edge, and the worst pixel at an edge on a cell boundary
@@ -57,12 +59,13 @@ def smooth(a, sigma):
     return np.convolve(a, k, "same")
 
 
-def profiles(c, edge, floor, samples=1_000_000, rays=60_000):
-    """The layer's and the truth's coverage of PIXELS, and whether the layer is sharp."""
+def profiles(c, edge, floor, samples=1_000_000, rays=60_000, share=1.0):
+    """The layer's and the truth's coverage of PIXELS, and whether the layer is sharp (below
+    `share` times the grid's own blur: LayerOptions::sharpShare)."""
     sigma = min(max(floor, 0.15 * c), 2.0)
     grid_blur = CELL_BLUR + sigma ** 2
     ray_a, ray_b = shaped(np.sqrt(grid_blur) / c) if 0.25 * c * c >= grid_blur else (0.0, 0.0)
-    sharp = 0.25 * c * c < CELL_BLUR + 0.25
+    sharp = 0.25 * c * c < share * (CELL_BLUR + 0.25)
     x = 40 + 16 * RNG.random(samples)
     ux, _ = disc(samples)
     pos = x + c * ux
@@ -100,6 +103,16 @@ def main():
             if k in (0, 4):
                 worst.append(np.abs(err).max())
         print(f"{floor:5.2f}  {c:7.2f}  {int(sharp):5d}  {total:32.5f}  {worst[0]:.3f}, {worst[1]:.3f}")
+    print("sharpShare 0.5 (Monte Carlo at 16 spp), floor 0.25:")
+    for c in (1.0, 1.1, 1.2, 1.3):
+        total, worst = 0.0, []
+        for k in range(8):
+            layer, truth, sharp = profiles(c, 48 + k / 8, 0.25, share=0.5)
+            err = layer - truth
+            total += (err ** 2).sum() / 8
+            if k in (0, 4):
+                worst.append(np.abs(err).max())
+        print(f"{0.25:5.2f}  {c:7.2f}  {int(sharp):5d}  {total:32.5f}  {worst[0]:.3f}, {worst[1]:.3f}")
 
 
 if __name__ == "__main__":

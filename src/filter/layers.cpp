@@ -127,7 +127,7 @@ constexpr float kCellBlur = 1.f / 12.f + 1.f / 6.f;
 /// length |m| (m^2 / 12), below the grid's own with the smallest Gaussian.
 inline bool isSharp(float c, float spread, float motion, const LayerOptions& o) {
     const float trueBlur = 0.25f * sqr(std::abs(c) + 0.5f * spread) + sqr(motion) / 12.f;
-    return trueBlur < kCellBlur + sqr(o.sigmaMin);
+    return trueBlur < o.sharpShare * (kCellBlur + sqr(o.sigmaMin));
 }
 
 /// The cell of a grid whose cell (i, j) covers the pixel [gx0 + i, gx0 + i + 1) x [gy0 + j, gy0 + j

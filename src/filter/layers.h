@@ -31,7 +31,8 @@
 //    and the slopes' with one of clamp(0.15 |c_l|, 0.25, 2); cells without weight (the layer
 //    hidden there) are filled from their neighbours. A layer whose true blur (a disc of radius
 //    |c|, a segment of length |m|) is below the grid's own with the radiance's Gaussian is
-//    "sharp": not reprojected, its grid its pixels' own samples.
+//    "sharp": not reprojected, its grid its pixels' own samples (for samples that carry their
+//    own radiance, below half the grid's own at 16 samples per pixel: LayerOptions::sharpShare).
 // 3. Each pixel is the mean of 32 reconstruction rays (x, y, u, v, t), a 5D Kronecker sequence
 //    shifted per pixel, so that pixel, lens and shutter are stratified jointly. Front to back, a
 //    ray takes each layer's alpha and premultiplied radiance at its shear, with the slope and
@@ -79,6 +80,14 @@ struct LayerOptions {
     // by 5%, cornell-sphere by 4%; docs/layers.md, "What the mixed pixels' error is made of".)
     float sigmaCoverageMin = 0.25f;
     float splitMin = 0.5f, splitScale = 0.15f;  // a layer's slopes spread at most max(splitMin, splitScale |c|)
+    // A layer is sharp (its pixels' own samples, not reprojected) while its true blur is below
+    // sharpShare times the grid's own with the smallest Gaussian (kCellBlur + sigmaMin^2): at 1
+    // a blurred layer is never blurred beyond its true blur's variance. Below 1, a near-focus
+    // layer shares its samples over the grid at the price of up to 1 / sharpShare times its
+    // true blur's variance: for samples that carry their own (noisy) radiance the renderer sets
+    // clamp(sqrt(samples per pixel / 64), 0.5, 1) (reconstructFromLayers; docs/layers.md,
+    // "Near-focus layers share their samples").
+    float sharpShare = 1.f;
     // At most this many layers a tile: past it the split's thresholds widen (x 1.5 until they
     // fit), which merges layers whose visibility then goes unresolved. Consecutive still layers
     // that are each sharp count as one (they composite exactly as one: mergeSharp).
