@@ -132,9 +132,10 @@ Image3f reconstructFromLayers(const MethodContext& ctx,
     // Samples that carry their own radiance (mc) are as noisy as a pixel's few samples: there a
     // near-focus layer (true blur at least half the grid's own at 16 samples per pixel, all of
     // it from 64) is reconstructed from the samples of its neighbourhood rather than its
-    // pixels' own. Measured at 16 spp, 512x512, MC relMSE 10-29% lower on the five lens scenes
-    // and 5-23% on the held-out ones with a lens; filtered light (aaf, maaf, atrous) measured
-    // worse with it (docs/layers.md, "Near-focus layers share their samples").
+    // pixels' own. Measured at 16 spp, 512x512, MC relMSE 9-29% lower on the five lens scenes
+    // and up to 23% on the held-out ones with a lens (docs/bunny-near.json +1%); filtered light
+    // (aaf, maaf, atrous) measured worse with it (docs/layers.md, "Near-focus layers share their
+    // samples").
     const bool ownRadiance = std::all_of(surfaceLight.begin(), surfaceLight.end(), [](const Image3f* l) { return l == nullptr; });
     if (ownRadiance) {
         const double perPixel = double(ctx.lightField->samples()) / double(std::max<size_t>(1, size_t(fb.width) * fb.height));
