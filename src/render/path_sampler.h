@@ -123,14 +123,14 @@ private:
     /// sampleLight's sample of a sphere light (`index`), chosen with probability pChoice.
     LightSample sampleSphere(const scene::AreaLight& light, uint32_t index, const Vec3f& p, const Vec3f& n, Vec2f u,
                              float pChoice) const;
+    /// The surface of a camera ray's hit into o (hit, albedo, the shading normal turned to the
+    /// side of `geometric`, the geometric normal facing the ray; position, depth, object): what
+    /// PixelStats::slotOf compares, so traceMany and primaryHits must take it alike.
+    void setPrimaryHit(TracedSample& o, const scene::Hit& hit, const Vec3f& geometric) const;
     /// The camera rays of samples first .. first+n-1 (n <= 16) of a pixel into `primary`, with
     /// each sample's lens point, light choice and shutter time, and (unless null) the point it
     /// samples on the light, drawn with the choice and time: what traceBatch and meanEmission
     /// share, so that they trace the same rays.
-    /// The surface of a camera ray's hit into o (hit, albedo, the shading normal on the side of
-    /// `geometric`, the geometric normal facing the ray; position, depth, object): what
-    /// PixelStats::slotOf compares, so traceMany and primaryHits must take it alike.
-    void setPrimaryHit(TracedSample& o, const scene::Hit& hit, const Vec3f& geometric) const;
     void cameraRays(const PixelSampler& rng, int x, int y, uint32_t first, int n, scene::RayPacket& primary,
                     Vec2f* lens, float* choice, float* time, Vec2f* uLight, Vec2f* film = nullptr) const;
     Vec3f offset(const Vec3f& p, const Vec3f& n) const { return p + n * m_epsilon; }
