@@ -92,28 +92,25 @@ def profiles(c, edge, floor, samples=1_000_000, rays=60_000, share=1.0):
     return np.array(layer), np.array(truth), sharp
 
 
+def row(floor, c, share=1.0):
+    """One line of the table: the edge's squared error over 8 positions, the worst pixels."""
+    total, worst = 0.0, []
+    for k in range(8):
+        layer, truth, sharp = profiles(c, 48 + k / 8, floor, share=share)
+        err = layer - truth
+        total += (err ** 2).sum() / 8
+        if k in (0, 4):
+            worst.append(np.abs(err).max())
+    print(f"{floor:5.2f}  {c:7.2f}  {int(sharp):5d}  {total:32.5f}  {worst[0]:.3f}, {worst[1]:.3f}")
+
+
 def main():
     print("floor  slope c  sharp  mean squared error (8 positions)  worst |error| at E = 48, 48.5")
     for floor, c in [(f, c) for f in (0.5, 0.25) for c in (1.2, 1.45, 1.49, 1.6, 1.7, 2.0, 2.5, 3.5, 5.0)]:
-        total, worst = 0.0, []
-        for k in range(8):
-            layer, truth, sharp = profiles(c, 48 + k / 8, floor)
-            err = layer - truth
-            total += (err ** 2).sum() / 8
-            if k in (0, 4):
-                worst.append(np.abs(err).max())
-        print(f"{floor:5.2f}  {c:7.2f}  {int(sharp):5d}  {total:32.5f}  {worst[0]:.3f}, {worst[1]:.3f}")
+        row(floor, c)
     print("sharpShare 0.5 (Monte Carlo at 16 spp), floor 0.25:")
     for c in (1.0, 1.1, 1.2, 1.3):
-        total, worst = 0.0, []
-        for k in range(8):
-            layer, truth, sharp = profiles(c, 48 + k / 8, 0.25, share=0.5)
-            err = layer - truth
-            total += (err ** 2).sum() / 8
-            if k in (0, 4):
-                worst.append(np.abs(err).max())
-        print(f"{0.25:5.2f}  {c:7.2f}  {int(sharp):5d}  {total:32.5f}  {worst[0]:.3f}, {worst[1]:.3f}")
-
+        row(0.25, c, share=0.5)
 
 if __name__ == "__main__":
     main()
