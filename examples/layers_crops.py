@@ -5,9 +5,9 @@ and `--layers on` at the same samples, beside a high-sample MC reference, enlarg
 crop's relMSE against the reference's crop.
 
     export PYTHONPATH=$PWD/build/python
-    python3 examples/layers_crops.py --out docs/layers-crops.png     # about 3 minutes on 2 cores
+    python3 examples/layers_crops.py --out docs/layers-crops.png     # 1.5 minutes on 2 cores
 
-The crops are the rows of CROPS (scene, x, y, width, height at the scene's resolution); the
+The crops are the rows of CROPS (scene, resolution, crop x, y, width, height); the
 reference is plain MC without layers with its own seed, so that its noise is independent of
 the renders'.
 """
@@ -27,7 +27,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 CROPS = [
     ("defocused silhouette: a chair's back over its seat and the floor", "conference", (512, 512), 226, 276, 120, 80),
     ("near the focal plane: chair backs behind the table, the wall", "conference", (512, 512), 96, 180, 120, 80),
-    ("motion: the trailing end of a moving sphere", os.path.join(HERE, "..", "docs", "motion.json"), None, 40, 84, 90, 60),
+    ("motion: the trailing end of a moving sphere", os.path.join(HERE, "..", "docs", "motion.json"), (256, 256), 40, 84, 90, 60),
 ]
 COLUMNS = [("mc", "off"), ("mc", "on"), ("aaf", "off"), ("aaf", "on")]
 
@@ -49,16 +49,22 @@ def main():
     p.add_argument("--reference-spp", type=int, default=1024, help="MC reference samples per pixel (default 1024)")
     p.add_argument("--seed", type=int, default=1)
     p.add_argument("--zoom", type=int, default=2, help="enlargement of the crops (default 2)")
+    p.add_argument("--scale", type=float, default=1.0,
+                   help="scale of every resolution and crop (default 1; the tests run 0.125)")
     p.add_argument("--out", default="layers-crops.png", help="output PNG (default layers-crops.png)")
     a = p.parse_args()
+    if not 0 < a.scale <= 4:
+        p.error("--scale: expected a number in (0, 4]")
+    crops = [(label, name, tuple(max(8, round(v * a.scale)) for v in res), *(max(1, round(v * a.scale)) for v in box))
+             for label, name, res, *box in CROPS]
 
     images = {}  # (scene, resolution) -> {column or "reference": colour}
-    for _, name, res, *_ in CROPS:
+    for _, name, res, *_ in crops:
         key = (name, res)
         if key in images:
             continue
         scene = wedge.load_scene(name)
-        common = dict(quiet=True, **({"resolution": res} if res else {}))
+        common = dict(quiet=True, resolution=res)
         row = {"reference": wedge.render(scene, method="mc", spp=a.reference_spp, layers="off",
                                          seed=a.seed + 1000, **common).color}
         for method, layers in COLUMNS:
@@ -69,12 +75,12 @@ def main():
 
     titles = [f"{m.upper()}, --layers {l}" for m, l in COLUMNS] + [f"reference (MC {a.reference_spp} spp)"]
     keys = COLUMNS + ["reference"]
-    heights = [c[6] for c in CROPS]
-    width = CROPS[0][5]
-    fig, axes = plt.subplots(len(CROPS), len(keys), squeeze=False, layout="constrained",
-                             figsize=(len(keys) * width * a.zoom / 100, sum(heights) * a.zoom / 100 + 0.35 * len(CROPS) + 0.3),
+    heights = [c[6] for c in crops]
+    width = crops[0][5]
+    fig, axes = plt.subplots(len(crops), len(keys), squeeze=False, layout="constrained",
+                             figsize=(len(keys) * width * a.zoom / 100, sum(heights) * a.zoom / 100 + 0.35 * len(crops) + 0.3),
                              gridspec_kw={"height_ratios": heights})
-    for r, (label, name, res, x, y, w, h) in enumerate(CROPS):
+    for r, (label, name, res, x, y, w, h) in enumerate(crops):
         row = images[(name, res)]
         ref = row["reference"][y:y + h, x:x + w]
         for c, key in enumerate(keys):
@@ -86,7 +92,7 @@ def main():
             text = titles[c] if key == "reference" else f"{titles[c]}\nrelMSE {rel_mse(crop, ref):.2g}"
             ax.set_title(text, fontsize=7)
         axes[r, 0].set_ylabel(label.split(":")[0], fontsize=7)
-    fig.suptitle(f"{a.spp} spp (AAF: initial), the same seed; rows: " + "; ".join(c[0] for c in CROPS), fontsize=7,
+    fig.suptitle(f"{a.spp} spp (AAF: initial), the same seed; rows: " + "; ".join(c[0] for c in crops), fontsize=7,
                  wrap=True)
     fig.savefig(a.out, dpi=100)
     print("wrote", a.out)

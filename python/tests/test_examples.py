@@ -1,4 +1,4 @@
-"""The two example scripts run as a user runs them (a fresh python3, PYTHONPATH as the README
+"""The example scripts run as a user runs them (a fresh python3, PYTHONPATH as the README
 says) at a tiny resolution, and write PNG figures matplotlib reads back."""
 import subprocess
 import sys
@@ -32,4 +32,10 @@ def test_methods_side_by_side(tmp_path):
 def test_convergence(tmp_path):
     out = tmp_path / "convergence.png"
     run_example("convergence.py", "--resolution", "16x12", "--spp", "1,2", "--reference-spp", "4", "--out", out)
+    check_png(out)
+
+
+def test_layers_crops(tmp_path):
+    out = tmp_path / "crops.png"
+    run_example("layers_crops.py", "--scale", "0.125", "--spp", "2", "--reference-spp", "4", "--zoom", "8", "--out", out)
     check_png(out)
