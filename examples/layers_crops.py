@@ -38,11 +38,6 @@ def display(linear):
     return np.where(x <= 0.0031308, 12.92 * x, 1.055 * np.power(x, 1 / 2.4) - 0.055)
 
 
-def rel_mse(test, ref, eps=0.01):
-    """relMSE as `wedge compare` computes it: (x - r)^2 / (r^2 + eps), averaged over pixels and channels."""
-    return float(np.mean((test - ref) ** 2 / (ref ** 2 + eps)))
-
-
 def main():
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     p.add_argument("--spp", type=int, default=16, help="samples per pixel of every render (initial for aaf; default 16)")
@@ -89,7 +84,7 @@ def main():
             ax.imshow(display(crop), interpolation="nearest")
             ax.set_xticks([])
             ax.set_yticks([])
-            text = titles[c] if key == "reference" else f"{titles[c]}\nrelMSE {rel_mse(crop, ref):.2g}"
+            text = titles[c] if key == "reference" else f"{titles[c]}\nrelMSE {wedge.compare(crop, ref)['relmse']:.2g}"
             ax.set_title(text, fontsize=7)
         axes[r, 0].set_ylabel(label.split(":")[0], fontsize=7)
     fig.suptitle(f"{a.spp} spp (AAF: initial), the same seed; rows: " + "; ".join(c[0] for c in crops), fontsize=7,

@@ -112,5 +112,6 @@ def main():
     for c in (1.0, 1.1, 1.2, 1.3):
         row(0.25, c, share=0.5)
 
+
 if __name__ == "__main__":
     main()
