@@ -27,7 +27,8 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 CROPS = [
     ("defocused silhouette: a chair's back over its seat and the floor", "conference", (512, 512), 226, 276, 120, 80),
     ("near the focal plane: chair backs behind the table, the wall", "conference", (512, 512), 96, 180, 120, 80),
-    ("motion: the trailing end of a moving sphere", os.path.join(HERE, "..", "docs", "motion.json"), (256, 256), 40, 84, 90, 60),
+    ("motion: the trailing end of a moving sphere", os.path.join(HERE, "..", "docs", "motion.json"), (256, 256),
+     40, 84, 90, 60),
 ]
 COLUMNS = [("mc", "off"), ("mc", "on"), ("aaf", "off"), ("aaf", "on")]
 
@@ -40,7 +41,8 @@ def display(linear):
 
 def main():
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    p.add_argument("--spp", type=int, default=16, help="samples per pixel of every render (initial for aaf; default 16)")
+    p.add_argument("--spp", type=int, default=16,
+                   help="samples per pixel of every render (initial for aaf; default 16)")
     p.add_argument("--reference-spp", type=int, default=1024, help="MC reference samples per pixel (default 1024)")
     p.add_argument("--seed", type=int, default=1)
     p.add_argument("--zoom", type=int, default=2, help="enlargement of the crops (default 2)")
@@ -73,7 +75,8 @@ def main():
     heights = [c[6] for c in crops]
     width = crops[0][5]
     fig, axes = plt.subplots(len(crops), len(keys), squeeze=False, layout="constrained",
-                             figsize=(len(keys) * width * a.zoom / 100, sum(heights) * a.zoom / 100 + 0.35 * len(crops) + 0.3),
+                             figsize=(len(keys) * width * a.zoom / 100,
+                                      sum(heights) * a.zoom / 100 + 0.35 * len(crops) + 0.3),
                              gridspec_kw={"height_ratios": heights})
     for r, (label, name, res, x, y, w, h) in enumerate(crops):
         row = images[(name, res)]
