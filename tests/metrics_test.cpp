@@ -408,6 +408,51 @@ TEST(CompareCommand, VarianceFromASecondRenderSplitsTheError) {
     EXPECT_NE(err.find("--variance-from"), std::string::npos) << err;
 }
 
+TEST(CompareCommand, TheReferencesOwnNoiseIsMeasuredAndTakenOff) {
+    // A 4-spp render against a 16-spp reference: a quarter of the relMSE is the reference's own
+    // noise. A second 16-spp reference with another seed measures it, and the net relMSE is what
+    // a 16x better reference measures (its own noise, 1/16 of the 16-spp one's, taken off too).
+    std::string dir = test::tempDir(), out, err;
+    const std::string common = " --method mc --resolution 48x48 --layers off --quiet ";
+    for (const char* r : {"--spp 4 --seed 1 -o a.exr", "--spp 16 --seed 9 -o r1.exr", "--spp 16 --seed 10 -o r2.exr",
+                          "--spp 256 --seed 11 -o big.exr"}) {
+        std::string args = r;
+        args.replace(args.find("-o ") + 3, 0, dir + "/");
+        ASSERT_EQ(test::runWedge("render cornell" + common + args, &out, &err), 0) << err;
+    }
+    auto json = [&](const std::string& args) {
+        EXPECT_EQ(test::runWedge("compare " + args + " --json", &out, &err), 0) << err;
+        return nlohmann::json::parse(out);
+    };
+    const double truthA = json(dir + "/a.exr " + dir + "/big.exr")["relmse"].get<double>();
+    const double truthR1 = json(dir + "/r1.exr " + dir + "/big.exr")["relmse"].get<double>();
+    // (Each relMSE against big.exr holds big.exr's noise, about a sixteenth of r1's.)
+    auto j = json(dir + "/a.exr " + dir + "/r1.exr --regions --reference-noise-from " + dir + "/r2.exr");
+    const double relmse = j["relmse"].get<double>(), noise = j["reference_noise"].get<double>();
+    EXPECT_NEAR(noise, truthR1 * 15.0 / 16.0, 0.15 * truthR1);
+    EXPECT_NEAR(j["relmse_net"].get<double>(), relmse - noise, 1e-12);
+    EXPECT_NEAR(j["relmse_net"].get<double>(), truthA - truthR1 / 16.0, 0.08 * truthA);
+    EXPECT_GT(noise, 0.1 * relmse);  // the correction matters here
+    double weighted = 0;
+    for (const auto& [name, r] : j["regions"].items()) {
+        weighted += r["pixels"].get<double>() * r["reference_noise"].get<double>();
+        EXPECT_NEAR(r["relmse_net"].get<double>(), r["relmse"].get<double>() - r["reference_noise"].get<double>(), 1e-12);
+    }
+    EXPECT_NEAR(weighted, noise, 1e-6 * noise);
+    // With --variance-from as well, the squared bias is what is left of the net relMSE.
+    j = json(dir + "/a.exr " + dir + "/r1.exr --variance-from " + dir + "/r2.exr --reference-noise-from " + dir + "/r2.exr");
+    EXPECT_NEAR(j["bias2"].get<double>(), relmse - j["variance"].get<double>() - noise, 1e-12);
+    // The text form names it.
+    ASSERT_EQ(test::runWedge("compare " + dir + "/a.exr " + dir + "/r1.exr --reference-noise-from " + dir + "/r2.exr", &out, &err), 0);
+    EXPECT_NE(out.find("net relMSE"), std::string::npos) << out;
+    // A second reference of another size, or not finite, is bad input that names it.
+    io::writePfm(dir + "/small.pfm", constant(4, 4, 1.f));
+    EXPECT_EQ(test::runWedge("compare " + dir + "/a.exr " + dir + "/r1.exr --reference-noise-from " + dir + "/small.pfm", &out, &err), 2);
+    EXPECT_NE(err.find(dir + "/small.pfm: --reference-noise-from"), std::string::npos) << err;
+    EXPECT_EQ(test::runWedge("compare " + dir + "/a.exr " + dir + "/r1.exr --reference-noise-from " + dir + "/missing.exr", &out, &err), 2);
+    EXPECT_NE(err.find("missing.exr"), std::string::npos) << err;
+}
+
 TEST(CompareCommand, BadInputExitsWithTwo) {
     std::string dir = test::tempDir();
     io::writePfm(dir + "/a.pfm", constant(4, 4, 1.f));

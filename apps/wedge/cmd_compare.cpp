@@ -1,8 +1,9 @@
 // wedge compare TEST REF [--json] [--heatmap OUT.png] [--regions] [--variance-from OTHER
-// [--bias-heatmap OUT.png]]: relMSE, SMAPE, PSNR and SSIM of a rendering against a reference
-// (metrics/metrics.h), a heat map of the per-pixel relative squared error on a log scale, where
-// that error sits (metrics::regionErrors), how much of it is variance (metrics::seedVariance, from
-// a second render with another seed) and where the squared bias is (metrics::seedBiasMap).
+// [--bias-heatmap OUT.png]] [--reference-noise-from REF2]: relMSE, SMAPE, PSNR and SSIM of a
+// rendering against a reference (metrics/metrics.h), a heat map of the per-pixel relative squared
+// error on a log scale, where that error sits (metrics::regionErrors), how much of it is variance
+// (metrics::seedVariance, from a second render with another seed), where the squared bias is
+// (metrics::seedBiasMap), and how much is the reference's own noise (from a second reference).
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -21,7 +22,7 @@ namespace wedge::app {
 namespace {
 
 struct CompareArgs {
-    std::string test, reference, heatmap, varianceFrom, biasHeatmap;
+    std::string test, reference, heatmap, varianceFrom, biasHeatmap, noiseFrom;
     bool json = false, regions = false;
 };
 
@@ -62,6 +63,23 @@ void runCompare(const CompareArgs& a) {
         variance = metrics::seedVarianceMap(test, *other, reference);
     }
     const double varianceMean = variance ? metrics::mapMean(*variance) : 0.0;
+    // The reference's own noise, from a second reference made alike with another seed: every
+    // relMSE against REF holds it, E[relMSE(x, REF)] = relMSE(x, truth) + E[Var REF / (REF^2 +
+    // eps)], and half REF and REF2's relative squared difference estimates the second term, per
+    // pixel (metrics::seedVarianceMap of the two references). The net relMSE is what a
+    // noise-free reference would measure; it is what separates two good filters (against a
+    // 1024-spp reference the reference's noise can be a third of a filtered render's relMSE).
+    std::optional<Image1f> noise;
+    if (!a.noiseFrom.empty()) {
+        const Image3f second = io::readColor(a.noiseFrom);
+        metrics::requireFinite(second, a.noiseFrom);
+        if (!second.sameSize(reference))
+            throw Error(a.noiseFrom, "--reference-noise-from: image size " + std::to_string(second.width()) + "x" +
+                                         std::to_string(second.height()) + " differs from " + a.reference + "'s " +
+                                         std::to_string(reference.width()) + "x" + std::to_string(reference.height()));
+        noise = metrics::seedVarianceMap(reference, second, reference);
+    }
+    const double noiseMean = noise ? metrics::mapMean(*noise) : 0.0;
     std::vector<metrics::RegionError> regions;
     if (a.regions) {
         if (io::extension(a.test) != ".exr")
@@ -70,7 +88,8 @@ void runCompare(const CompareArgs& a) {
         const Image1f object = plane(exr, a.test, "object"), coverage = plane(exr, a.test, "coverage"),
                       defocus = plane(exr, a.test, "slope.defocus"), occluded = plane(exr, a.test, "slope.occluded");
         regions = metrics::regionErrors(test, reference, {object, coverage, defocus, occluded}, 2,
-                                        metrics::kRelMseEpsilon, variance ? &*variance : nullptr);
+                                        metrics::kRelMseEpsilon, variance ? &*variance : nullptr,
+                                        noise ? &*noise : nullptr);
     }
     metrics::Metrics m = metrics::compare(test, reference);
     if (!a.heatmap.empty())
@@ -93,11 +112,20 @@ void runCompare(const CompareArgs& a) {
             j["variance"] = varianceMean;
             j["bias2_and_reference_noise"] = m.relMse - varianceMean;
         }
+        if (noise) {
+            j["reference_noise"] = noiseMean;
+            j["relmse_net"] = m.relMse - noiseMean;
+            if (variance) j["bias2"] = m.relMse - varianceMean - noiseMean;
+        }
         if (a.regions) {
             nlohmann::json r = nlohmann::json::object();
             for (const auto& c : regions) {
                 r[c.name] = {{"pixels", c.pixels}, {"share", c.share}, {"relmse", c.relMse}};
                 if (variance) r[c.name]["variance"] = c.variance;
+                if (noise) {
+                    r[c.name]["reference_noise"] = c.noise;
+                    r[c.name]["relmse_net"] = c.relMse - c.noise;
+                }
             }
             j["regions"] = r;
         }
@@ -110,14 +138,25 @@ void runCompare(const CompareArgs& a) {
         if (variance) {
             std::printf("variance %.6g  (half the relative squared difference from %s)\n", varianceMean,
                         a.varianceFrom.c_str());
-            std::printf("rest     %.6g  (relMSE - variance: squared bias + the reference's own noise)\n",
-                        m.relMse - varianceMean);
+            if (!noise)
+                std::printf("rest     %.6g  (relMSE - variance: squared bias + the reference's own noise)\n",
+                            m.relMse - varianceMean);
+        }
+        if (noise) {
+            std::printf("reference noise %.6g  (half the relative squared difference of %s from %s)\n", noiseMean,
+                        a.reference.c_str(), a.noiseFrom.c_str());
+            std::printf("net relMSE      %.6g  (relMSE - reference noise: against a noise-free reference)\n",
+                        m.relMse - noiseMean);
+            if (variance)
+                std::printf("bias2           %.6g  (net relMSE - variance)\n", m.relMse - varianceMean - noiseMean);
         }
         if (a.regions) {
-            std::printf("%-11s %8s %8s %10s%s\n", "region", "pixels", "error", "relMSE", variance ? "   variance" : "");
+            std::printf("%-11s %8s %8s %10s%s%s\n", "region", "pixels", "error", "relMSE", variance ? "   variance" : "",
+                        noise ? "  ref noise  net relMSE" : "");
             for (const auto& c : regions) {
                 std::printf("%-11s %7.1f%% %7.1f%% %10.4g", c.name.c_str(), 100 * c.pixels, 100 * c.share, c.relMse);
                 if (variance) std::printf(" %10.4g", c.variance);
+                if (noise) std::printf(" %10.4g  %10.4g", c.noise, c.relMse - c.noise);
                 std::printf("\n");
             }
         }
@@ -139,6 +178,9 @@ void registerCompare(CLI::App& app) {
     cmd->add_option("--variance-from", args->varianceFrom,
                     "A render made like TEST but with another --seed: splits TEST's relMSE into variance and the "
                     "rest (squared bias + the reference's own noise)");
+    cmd->add_option("--reference-noise-from", args->noiseFrom,
+                    "A second reference made like REFERENCE but with another --seed: estimates REFERENCE's own noise "
+                    "(part of every relMSE against it) and reports relMSE net of it, overall and per region");
     cmd->add_option("--heatmap", args->heatmap, "Write a heat map of log10 relative squared error (10^-4..1) as PNG");
     cmd->add_option("--bias-heatmap", args->biasHeatmap,
                     "With --variance-from: write a heat map of the squared bias, (TEST - REF)(OTHER - REF) / (REF^2 + "

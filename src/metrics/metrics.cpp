@@ -146,9 +146,10 @@ Image<uint8_t> regionClasses(const RegionPlanes& planes, int edgeRadius) {
 }
 
 std::vector<RegionError> regionErrors(const Image3f& test, const Image3f& reference, const Image<uint8_t>& classes,
-                                      float eps, const Image1f* variance) {
-    if (!classes.sameSize(test) || !test.sameSize(reference) || (variance && !variance->sameSize(test)))
-        throw Error("regions", "the pixel classes, the images and the variance map differ in size");
+                                      float eps, const Image1f* variance, const Image1f* noise) {
+    if (!classes.sameSize(test) || !test.sameSize(reference) || (variance && !variance->sameSize(test)) ||
+        (noise && !noise->sameSize(test)))
+        throw Error("regions", "the pixel classes, the images and the variance or noise maps differ in size");
     const Image1f e = relativeErrorMap(test, reference, eps);
     std::vector<RegionError> r;
     for (const auto& name : regionNames()) r.push_back({name});
@@ -158,12 +159,14 @@ std::vector<RegionError> regionErrors(const Image3f& test, const Image3f& refere
         c.pixels += 1;
         c.share += e[i];
         if (variance) c.variance += (*variance)[i];
+        if (noise) c.noise += (*noise)[i];
         total += e[i];
     }
     const double n = double(classes.size());
     for (auto& c : r) {
         c.relMse = c.pixels > 0 ? c.share / c.pixels : 0.0;
         c.variance = c.pixels > 0 ? c.variance / c.pixels : 0.0;
+        c.noise = c.pixels > 0 ? c.noise / c.pixels : 0.0;
         c.share = total > 0 ? c.share / total : 0.0;
         c.pixels = n > 0 ? c.pixels / n : 0.0;
     }
@@ -171,8 +174,8 @@ std::vector<RegionError> regionErrors(const Image3f& test, const Image3f& refere
 }
 
 std::vector<RegionError> regionErrors(const Image3f& test, const Image3f& reference, const RegionPlanes& planes,
-                                      int edgeRadius, float eps, const Image1f* variance) {
-    return regionErrors(test, reference, regionClasses(planes, edgeRadius), eps, variance);
+                                      int edgeRadius, float eps, const Image1f* variance, const Image1f* noise) {
+    return regionErrors(test, reference, regionClasses(planes, edgeRadius), eps, variance, noise);
 }
 
 double smape(const Image3f& test, const Image3f& reference, float eps) {

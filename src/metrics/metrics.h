@@ -77,13 +77,16 @@ Image3f combineHalves(const Image3f& halfA, int nA, const Image3f& halfB, int nB
 /// were blocked, the pixels where a shadow filter's width and components matter, defocused or
 /// not), defocused (slope.defocus above one pixel per lens radius) and interior (the rest). Each
 /// pixel falls in the first class that holds for it. With `variance` (seedVarianceMap of the test
-/// render and one with another seed), each class also gets its variance part.
+/// render and one with another seed), each class also gets its variance part; with `noise` (the
+/// reference's own noise per pixel: seedVarianceMap of the reference and a second reference made
+/// alike with another seed), its reference-noise part.
 struct RegionError {
     std::string name;
     double pixels = 0;    // fraction of the image's pixels
     double share = 0;     // fraction of the summed relative squared error
     double relMse = 0;    // mean over the class's pixels
     double variance = 0;  // mean of `variance` over the class's pixels (0 without it)
+    double noise = 0;     // mean of `noise` over the class's pixels (0 without it)
 };
 struct RegionPlanes {
     const Image1f& object;
@@ -93,7 +96,7 @@ struct RegionPlanes {
 };
 std::vector<RegionError> regionErrors(const Image3f& test, const Image3f& reference, const RegionPlanes& planes,
                                       int edgeRadius = 2, float eps = kRelMseEpsilon,
-                                      const Image1f* variance = nullptr);
+                                      const Image1f* variance = nullptr, const Image1f* noise = nullptr);
 /// The class names in index order ("background", ..., "interior").
 const std::vector<std::string>& regionNames();
 /// Each pixel's class (an index into regionNames()), from a render's planes: the first half of
@@ -101,7 +104,8 @@ const std::vector<std::string>& regionNames();
 Image<uint8_t> regionClasses(const RegionPlanes& planes, int edgeRadius = 2);
 /// The second half: the split over classes from regionClasses(). Throws Error on size mismatch.
 std::vector<RegionError> regionErrors(const Image3f& test, const Image3f& reference, const Image<uint8_t>& classes,
-                                      float eps = kRelMseEpsilon, const Image1f* variance = nullptr);
+                                      float eps = kRelMseEpsilon, const Image1f* variance = nullptr,
+                                      const Image1f* noise = nullptr);
 
 /// Every metric of an image with a NaN or infinite pixel is NaN or meaningless: throws
 /// wedge::Error naming `name` (a file), the count and the first such pixel instead.
