@@ -12,6 +12,7 @@
 #include <chrono>
 #include <filesystem>
 #include <future>
+#include <optional>
 #include <thread>
 
 #include "apps/wedge/render_flags.h"
@@ -264,24 +265,53 @@ PYBIND11_MODULE(wedge, m) {
         io::writeColor(path, imageFromArray(py::array_t<float, py::array::c_style | py::array::forcecast>::ensure(image), path));
     }, py::arg("path"), py::arg("image"), "Writes a linear (H, W, 3) float array as .exr (R, G, B), .png or .pfm.");
 
-    m.def("compare", [](const py::object& test, const py::object& reference) {
-        const std::string testName = isPath(test) ? pathOf(test) : "test";
-        const std::string refName = isPath(reference) ? pathOf(reference) : "reference";
+    m.def("compare", [](const py::object& test, const py::object& reference, const py::object& varianceFrom,
+                        const py::object& noiseFrom) {
+        auto nameOf = [](const py::object& x, const char* fallback) { return isPath(x) ? pathOf(x) : std::string(fallback); };
+        const std::string testName = nameOf(test, "test"), refName = nameOf(reference, "reference");
         const Image3f a = imageArgument(test, testName), b = imageArgument(reference, refName);
         metrics::checkComparable(a, testName, b, refName);
+        // As `wedge compare --variance-from OTHER --reference-noise-from REF2`: OTHER is TEST made
+        // with another seed, REF2 the reference made with another seed.
+        std::optional<Image3f> other, second;
+        if (!varianceFrom.is_none()) {
+            const std::string name = nameOf(varianceFrom, "variance_from");
+            other = imageArgument(varianceFrom, name);
+            metrics::checkComparable(*other, name, a, testName);
+        }
+        if (!noiseFrom.is_none()) {
+            const std::string name = nameOf(noiseFrom, "reference_noise_from");
+            second = imageArgument(noiseFrom, name);
+            metrics::checkComparable(*second, name, b, refName);
+        }
         metrics::Metrics mm;
+        double variance = 0, noise = 0;
         {
             py::gil_scoped_release release;
             mm = metrics::compare(a, b);
+            if (other) variance = metrics::seedVariance(a, *other, b);
+            if (second) noise = metrics::seedVariance(b, *second, b);
         }
         py::dict d;
         d["relmse"] = mm.relMse;
         d["smape"] = mm.smape;
         d["psnr"] = std::isfinite(mm.psnr) ? py::object(py::float_(mm.psnr)) : py::none();  // None: identical
         d["ssim"] = mm.ssim;
+        if (other) {
+            d["variance"] = variance;
+            d["bias2_and_reference_noise"] = mm.relMse - variance;
+        }
+        if (second) {
+            d["reference_noise"] = noise;
+            d["relmse_net"] = mm.relMse - noise;
+            if (other) d["bias2"] = mm.relMse - variance - noise;
+        }
         return d;
-    }, py::arg("test"), py::arg("reference"),
+    }, py::arg("test"), py::arg("reference"), py::kw_only(), py::arg("variance_from") = py::none(),
+          py::arg("reference_noise_from") = py::none(),
           "The metrics `wedge compare --json` prints of TEST against REFERENCE, each a Result, a path or a "
           "linear (H, W, 3) array: a dict with relmse (eps 0.01, no 0.5 factor), smape, psnr (dB, tone-mapped; "
-          "None for identical images) and ssim (tone-mapped).");
+          "None for identical images) and ssim (tone-mapped). variance_from (TEST made with another seed) adds "
+          "variance and bias2_and_reference_noise; reference_noise_from (REFERENCE made with another seed) adds "
+          "reference_noise and relmse_net, and with both, bias2.");
 }

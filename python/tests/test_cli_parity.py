@@ -43,6 +43,29 @@ def test_compare_equals_the_cli_json(cornell, tmp_path):
     assert wedge.compare(ref, ref)["relmse"] == 0
 
 
+def test_compare_splits_the_error_as_the_cli_does(cornell, tmp_path):
+    # variance_from and reference_noise_from give what --variance-from and --reference-noise-from
+    # print: the variance, the reference's own noise, the net relMSE and the squared bias.
+    kw = dict(spp=SPP, resolution=RESOLUTION, quiet=True)
+    images = {"a": wedge.render(cornell, method="mc", seed=1, **kw), "b": wedge.render(cornell, method="mc", seed=2, **kw),
+              "r1": wedge.render(cornell, method="mc", seed=3, **{**kw, "spp": 16}),
+              "r2": wedge.render(cornell, method="mc", seed=4, **{**kw, "spp": 16})}
+    for name, r in images.items():
+        wedge.write_image(str(tmp_path / f"{name}.exr"), r)
+    path = {name: str(tmp_path / f"{name}.exr") for name in images}
+    cli = json.loads(run_cli("compare", path["a"], path["r1"], "--json", "--variance-from", path["b"],
+                             "--reference-noise-from", path["r2"]).stdout)
+    got = wedge.compare(images["a"], images["r1"], variance_from=images["b"], reference_noise_from=path["r2"])
+    keys = ("relmse", "variance", "bias2_and_reference_noise", "reference_noise", "relmse_net", "bias2")
+    assert {k: got[k] for k in keys} == pytest.approx({k: cli[k] for k in keys}, rel=1e-12, abs=1e-15)
+    assert got["reference_noise"] > 0 and got["relmse_net"] == pytest.approx(got["relmse"] - got["reference_noise"])
+    # Either alone adds only its own keys; a second image of another size is the CLI's error.
+    assert "variance" not in wedge.compare(images["a"], images["r1"], reference_noise_from=images["r2"])
+    assert "reference_noise" not in wedge.compare(images["a"], images["r1"], variance_from=images["b"])
+    small = np.ones((4, 4, 3), np.float32)
+    assert "size mismatch" in error_of(wedge.compare, images["a"], images["r1"], reference_noise_from=small)
+
+
 def error_of(call, *args, **kwargs):
     with pytest.raises(wedge.Error) as e:
         call(*args, **kwargs)
