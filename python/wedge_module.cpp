@@ -15,6 +15,7 @@
 #include <optional>
 #include <thread>
 
+#include "apps/wedge/common.h"
 #include "apps/wedge/render_flags.h"
 #include "core/cancel.h"
 #include "core/error.h"
@@ -285,28 +286,14 @@ PYBIND11_MODULE(wedge, m) {
             metrics::checkComparable(*second, name, b, refName);
         }
         metrics::Metrics mm;
-        double variance = 0, noise = 0;
+        std::optional<double> variance, noise;
         {
             py::gil_scoped_release release;
             mm = metrics::compare(a, b);
             if (other) variance = metrics::seedVariance(a, *other, b);
             if (second) noise = metrics::seedVariance(b, *second, b);
         }
-        py::dict d;
-        d["relmse"] = mm.relMse;
-        d["smape"] = mm.smape;
-        d["psnr"] = std::isfinite(mm.psnr) ? py::object(py::float_(mm.psnr)) : py::none();  // None: identical
-        d["ssim"] = mm.ssim;
-        if (other) {
-            d["variance"] = variance;
-            d["bias2_and_reference_noise"] = mm.relMse - variance;
-        }
-        if (second) {
-            d["reference_noise"] = noise;
-            d["relmse_net"] = mm.relMse - noise;
-            if (other) d["bias2"] = mm.relMse - variance - noise;
-        }
-        return d;
+        return jsonToPython(app::metricsJson(mm, variance, noise));  // psnr None for identical images
     }, py::arg("test"), py::arg("reference"), py::kw_only(), py::arg("variance_from") = py::none(),
           py::arg("reference_noise_from") = py::none(),
           "The metrics `wedge compare --json` prints of TEST against REFERENCE, each a Result, a path or a "

@@ -100,23 +100,11 @@ void runCompare(const CompareArgs& a) {
                          metrics::log10Map(metrics::seedBiasMap(test, *other, reference), kBiasHeatLo),
                          kBiasHeatLo, kBiasHeatHi);
     if (a.json) {
-        nlohmann::json j;
+        nlohmann::json j = metricsJson(m, variance ? std::optional<double>(varianceMean) : std::nullopt,
+                                       noise ? std::optional<double>(noiseMean) : std::nullopt);
         j["test"] = a.test;
         j["reference"] = a.reference;
-        j["relmse"] = m.relMse;
         j["relmse_epsilon"] = metrics::kRelMseEpsilon;
-        j["smape"] = m.smape;
-        j["psnr"] = std::isfinite(m.psnr) ? nlohmann::json(m.psnr) : nlohmann::json(nullptr);  // null: identical
-        j["ssim"] = m.ssim;
-        if (variance) {
-            j["variance"] = varianceMean;
-            j["bias2_and_reference_noise"] = m.relMse - varianceMean;
-        }
-        if (noise) {
-            j["reference_noise"] = noiseMean;
-            j["relmse_net"] = m.relMse - noiseMean;
-            if (variance) j["bias2"] = m.relMse - varianceMean - noiseMean;
-        }
         if (a.regions) {
             nlohmann::json r = nlohmann::json::object();
             for (const auto& c : regions) {

@@ -79,6 +79,24 @@ CLI::Validator numberIn(double lo, double hi) {
                        [lo, hi](double v) { return v >= lo && v <= hi; });
 }
 
+nlohmann::json metricsJson(const metrics::Metrics& m, std::optional<double> variance, std::optional<double> noise) {
+    nlohmann::json j;
+    j["relmse"] = m.relMse;
+    j["smape"] = m.smape;
+    j["psnr"] = std::isfinite(m.psnr) ? nlohmann::json(m.psnr) : nlohmann::json(nullptr);  // null: identical
+    j["ssim"] = m.ssim;
+    if (variance) {
+        j["variance"] = *variance;
+        j["bias2_and_reference_noise"] = m.relMse - *variance;
+    }
+    if (noise) {
+        j["reference_noise"] = *noise;
+        j["relmse_net"] = m.relMse - *noise;
+        if (variance) j["bias2"] = m.relMse - *variance - *noise;
+    }
+    return j;
+}
+
 void writeJsonFile(const std::string& path, const nlohmann::json& j) { io::writeTextFile(path, j.dump(2) + "\n"); }
 
 }  // namespace wedge::app

@@ -3,8 +3,10 @@
 
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 
+#include "metrics/metrics.h"
 #include "scene/scene_desc.h"
 
 namespace wedge::app {
@@ -23,6 +25,12 @@ CLI::Validator numberIn(double lo, double hi);
 /// --max-memory SIZE on `cmd`: the limit that sizes from files and flags are checked against
 /// before anything is allocated (core/memory_limit.h); the machine's memory by default.
 void addMaxMemory(CLI::App* cmd);
+/// What `wedge compare --json` prints of an image against a reference, and the Python module's
+/// compare() returns: relmse, smape, psnr (null for identical images) and ssim; with `variance`
+/// (the test's, from a render with another seed) variance and bias2_and_reference_noise; with
+/// `noise` (the reference's own, from a reference with another seed) reference_noise and
+/// relmse_net; with both, bias2.
+nlohmann::json metricsJson(const metrics::Metrics& m, std::optional<double> variance, std::optional<double> noise);
 /// Writes JSON through a temporary file and a rename.
 void writeJsonFile(const std::string& path, const nlohmann::json& j);
 
