@@ -266,6 +266,40 @@ PYBIND11_MODULE(wedge, m) {
         io::writeColor(path, imageFromArray(py::array_t<float, py::array::c_style | py::array::forcecast>::ensure(image), path));
     }, py::arg("path"), py::arg("image"), "Writes a linear (H, W, 3) float array as .exr (R, G, B), .png or .pfm.");
 
+    m.def("read_image", [](const py::object& path) {
+        const std::string name = pathOf(path);
+        Image3f img;
+        {
+            py::gil_scoped_release release;
+            img = io::readColor(name);
+        }
+        py::array_t<float> a({py::ssize_t(img.height()), py::ssize_t(img.width()), py::ssize_t(3)});
+        std::copy(&img[0].x, &img[0].x + 3 * img.size(), a.mutable_data());
+        return a;
+    }, py::arg("path"),
+          "Reads an image as `wedge compare` reads it (.exr: its R, G, B; .png: sRGB decoded to linear; .pfm) "
+          "into a linear float32 array of shape (H, W, 3). Raises wedge.Error naming the file on bad input.");
+    m.def("read_buffers", [](const py::object& path) {
+        const std::string name = pathOf(path);
+        if (io::extension(name) != ".exr")
+            throw Error(name, "read_buffers() needs an EXR (written by `wedge render -o x.exr` or write_image())");
+        io::ExrImage exr;
+        {
+            py::gil_scoped_release release;
+            exr = io::readExr(name);
+        }
+        py::dict planes;
+        for (const auto& [channel, values] : exr.channels) {
+            if (channel == "R" || channel == "G" || channel == "B") continue;
+            py::array_t<float> a({py::ssize_t(exr.height), py::ssize_t(exr.width)});
+            std::copy(values.begin(), values.end(), a.mutable_data());
+            planes[py::str(channel)] = a;
+        }
+        return planes;
+    }, py::arg("path"),
+          "Reads an EXR's named buffers besides R, G, B (as Result.buffers has them: 'depth', 'spp', "
+          "'normal.X', ...) into a dict of float32 arrays of shape (H, W).");
+
     m.def("compare", [](const py::object& test, const py::object& reference, const py::object& varianceFrom,
                         const py::object& noiseFrom) {
         auto nameOf = [](const py::object& x, const char* fallback) { return isPath(x) ? pathOf(x) : std::string(fallback); };

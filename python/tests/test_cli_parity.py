@@ -47,7 +47,8 @@ def test_compare_splits_the_error_as_the_cli_does(cornell, tmp_path):
     # variance_from and reference_noise_from give what --variance-from and --reference-noise-from
     # print: the variance, the reference's own noise, the net relMSE and the squared bias.
     kw = dict(spp=SPP, resolution=RESOLUTION, quiet=True)
-    images = {"a": wedge.render(cornell, method="mc", seed=1, **kw), "b": wedge.render(cornell, method="mc", seed=2, **kw),
+    images = {"a": wedge.render(cornell, method="mc", seed=1, **kw),
+              "b": wedge.render(cornell, method="mc", seed=2, **kw),
               "r1": wedge.render(cornell, method="mc", seed=3, **{**kw, "spp": 16}),
               "r2": wedge.render(cornell, method="mc", seed=4, **{**kw, "spp": 16})}
     for name, r in images.items():
@@ -64,6 +65,26 @@ def test_compare_splits_the_error_as_the_cli_does(cornell, tmp_path):
     assert "reference_noise" not in wedge.compare(images["a"], images["r1"], variance_from=images["b"])
     small = np.ones((4, 4, 3), np.float32)
     assert "size mismatch" in error_of(wedge.compare, images["a"], images["r1"], reference_noise_from=small)
+
+
+def test_read_image_and_buffers_give_back_what_was_written(cornell, tmp_path):
+    # read_image() reads what `wedge compare` reads; read_buffers() an EXR's named planes.
+    r = wedge.render(cornell, method="aaf", spp=SPP, seed=SEED, resolution=RESOLUTION, quiet=True)
+    for ext in ("exr", "pfm", "png"):
+        wedge.write_image(str(tmp_path / f"x.{ext}"), r)
+    assert np.array_equal(wedge.read_image(tmp_path / "x.exr"), r.color)
+    assert np.array_equal(wedge.read_image(str(tmp_path / "x.pfm")), r.color)
+    png = wedge.read_image(tmp_path / "x.png")  # 8-bit sRGB decoded: what compare() measures of the file
+    assert png.shape == r.color.shape and png.dtype == np.float32
+    assert wedge.compare(png, r) == wedge.compare(str(tmp_path / "x.png"), r)
+    planes = wedge.read_buffers(tmp_path / "x.exr")
+    assert planes.keys() == r.buffers.keys() and "depth" in planes
+    assert all(np.array_equal(planes[k], r.buffers[k]) for k in planes)
+    # Bad input names the file, as the CLI does.
+    missing = tmp_path / "missing.exr"
+    assert error_of(wedge.read_image, missing) == cli_error("compare", missing, tmp_path / "x.exr")
+    message = error_of(wedge.read_buffers, tmp_path / "x.pfm")
+    assert message.startswith(f"{tmp_path / 'x.pfm'}: read_buffers() needs an EXR")
 
 
 def error_of(call, *args, **kwargs):
