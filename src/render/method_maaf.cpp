@@ -448,14 +448,15 @@ void renderMaaf(const MethodContext& ctx, RenderResult& result) {
 
     if (!ctx.options.aovDir.empty()) {
         const std::string& dir = ctx.options.aovDir;
-        // Per effect, along image x: the central component's standard deviation in pixels (at
-        // most the window) and the number of components.
+        // Per effect: the central component's standard deviation in pixels along image x (at
+        // most the window), and the number of components on the axis with more (a horizontal
+        // shadow edge has its outer components along image y only).
         auto effectAovs = [&](const filter::MaafEffect& effect, const Image<filter::AxisFrame>& axes, const std::string& name) {
             Image1f width(W, H), components(W, H);
             for (size_t i = 0; i < pixels; ++i) {
                 if (fb.object[i] < 0) continue;  // 0 in both maps
                 width[i] = std::min(float(mo.maxRadius), 1.f / (effect.centralSx(i, 0) * axes[i].step[0]));
-                components[i] = float(2 * effect.pairs(i, 0) - 1);
+                components[i] = float(2 * std::max(effect.pairs(i, 0), effect.pairs(i, 1)) - 1);
             }
             writeAov(dir, "maaf_central_width_" + name, width, 0, float(mo.maxRadius));
             writeAov(dir, "maaf_components_" + name, components, 0, float(2 * mo.pairs - 1));
