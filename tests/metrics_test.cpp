@@ -439,9 +439,16 @@ TEST(CompareCommand, TheReferencesOwnNoiseIsMeasuredAndTakenOff) {
         EXPECT_NEAR(r["relmse_net"].get<double>(), r["relmse"].get<double>() - r["reference_noise"].get<double>(), 1e-12);
     }
     EXPECT_NEAR(weighted, noise, 1e-6 * noise);
-    // With --variance-from as well, the squared bias is what is left of the net relMSE.
-    j = json(dir + "/a.exr " + dir + "/r1.exr --variance-from " + dir + "/r2.exr --reference-noise-from " + dir + "/r2.exr");
+    // With --variance-from as well, the squared bias is what is left of the net relMSE, overall
+    // and per region. (r2.exr stands in for a second render of a.exr's kind: any image does for
+    // the arithmetic.)
+    j = json(dir + "/a.exr " + dir + "/r1.exr --regions --variance-from " + dir + "/r2.exr --reference-noise-from " +
+             dir + "/r2.exr");
     EXPECT_NEAR(j["bias2"].get<double>(), relmse - j["variance"].get<double>() - noise, 1e-12);
+    for (const auto& [name, r] : j["regions"].items())
+        EXPECT_NEAR(r["bias2"].get<double>(),
+                    r["relmse"].get<double>() - r["variance"].get<double>() - r["reference_noise"].get<double>(), 1e-12)
+            << name;
     // The text form names it.
     ASSERT_EQ(test::runWedge("compare " + dir + "/a.exr " + dir + "/r1.exr --reference-noise-from " + dir + "/r2.exr", &out, &err), 0);
     EXPECT_NE(out.find("net relMSE"), std::string::npos) << out;

@@ -113,6 +113,7 @@ void runCompare(const CompareArgs& a) {
                 if (noise) {
                     r[c.name]["reference_noise"] = c.noise;
                     r[c.name]["relmse_net"] = c.relMse - c.noise;
+                    if (variance) r[c.name]["bias2"] = c.relMse - c.noise - c.variance;
                 }
             }
             j["regions"] = r;
@@ -139,12 +140,13 @@ void runCompare(const CompareArgs& a) {
                 std::printf("bias2           %.6g  (net relMSE - variance)\n", m.relMse - varianceMean - noiseMean);
         }
         if (a.regions) {
-            std::printf("%-11s %8s %8s %10s%s%s\n", "region", "pixels", "error", "relMSE", variance ? "   variance" : "",
-                        noise ? "  ref noise  net relMSE" : "");
+            std::printf("%-11s %8s %8s %10s%s%s%s\n", "region", "pixels", "error", "relMSE", variance ? "   variance" : "",
+                        noise ? "  ref noise  net relMSE" : "", variance && noise ? "      bias2" : "");
             for (const auto& c : regions) {
                 std::printf("%-11s %7.1f%% %7.1f%% %10.4g", c.name.c_str(), 100 * c.pixels, 100 * c.share, c.relMse);
                 if (variance) std::printf(" %10.4g", c.variance);
                 if (noise) std::printf(" %10.4g  %10.4g", c.noise, c.relMse - c.noise);
+                if (variance && noise) std::printf(" %10.4g", c.relMse - c.noise - c.variance);
                 std::printf("\n");
             }
         }
