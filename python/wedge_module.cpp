@@ -312,12 +312,12 @@ PYBIND11_MODULE(wedge, m) {
         if (!varianceFrom.is_none()) {
             const std::string name = nameOf(varianceFrom, "variance_from");
             other = imageArgument(varianceFrom, name);
-            metrics::checkComparable(*other, name, a, testName);
+            app::checkSecondImage(*other, name, "--variance-from", a, testName);
         }
         if (!noiseFrom.is_none()) {
             const std::string name = nameOf(noiseFrom, "reference_noise_from");
             second = imageArgument(noiseFrom, name);
-            metrics::checkComparable(*second, name, b, refName);
+            app::checkSecondImage(*second, name, "--reference-noise-from", b, refName);
         }
         metrics::Metrics mm;
         std::optional<double> variance, noise;

@@ -55,11 +55,7 @@ void runCompare(const CompareArgs& a) {
     std::optional<Image1f> variance;
     if (!a.varianceFrom.empty()) {
         other = io::readColor(a.varianceFrom);
-        metrics::requireFinite(*other, a.varianceFrom);
-        if (!other->sameSize(test))
-            throw Error(a.varianceFrom, "--variance-from: image size " + std::to_string(other->width()) + "x" +
-                                            std::to_string(other->height()) + " differs from " + a.test + "'s " +
-                                            std::to_string(test.width()) + "x" + std::to_string(test.height()));
+        checkSecondImage(*other, a.varianceFrom, "--variance-from", test, a.test);
         variance = metrics::seedVarianceMap(test, *other, reference);
     }
     const double varianceMean = variance ? metrics::mapMean(*variance) : 0.0;
@@ -72,11 +68,7 @@ void runCompare(const CompareArgs& a) {
     std::optional<Image1f> noise;
     if (!a.noiseFrom.empty()) {
         const Image3f second = io::readColor(a.noiseFrom);
-        metrics::requireFinite(second, a.noiseFrom);
-        if (!second.sameSize(reference))
-            throw Error(a.noiseFrom, "--reference-noise-from: image size " + std::to_string(second.width()) + "x" +
-                                         std::to_string(second.height()) + " differs from " + a.reference + "'s " +
-                                         std::to_string(reference.width()) + "x" + std::to_string(reference.height()));
+        checkSecondImage(second, a.noiseFrom, "--reference-noise-from", reference, a.reference);
         noise = metrics::seedVarianceMap(reference, second, reference);
     }
     const double noiseMean = noise ? metrics::mapMean(*noise) : 0.0;

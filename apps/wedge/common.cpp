@@ -97,6 +97,15 @@ nlohmann::json metricsJson(const metrics::Metrics& m, std::optional<double> vari
     return j;
 }
 
+void checkSecondImage(const Image3f& second, const std::string& secondName, const std::string& flag,
+                      const Image3f& first, const std::string& firstName) {
+    metrics::requireFinite(second, secondName);
+    if (!second.sameSize(first))
+        throw Error(secondName, flag + ": image size " + std::to_string(second.width()) + "x" +
+                                    std::to_string(second.height()) + " differs from " + firstName + "'s " +
+                                    std::to_string(first.width()) + "x" + std::to_string(first.height()));
+}
+
 void writeJsonFile(const std::string& path, const nlohmann::json& j) { io::writeTextFile(path, j.dump(2) + "\n"); }
 
 }  // namespace wedge::app

@@ -31,6 +31,11 @@ void addMaxMemory(CLI::App* cmd);
 /// `noise` (the reference's own, from a reference with another seed) reference_noise and
 /// relmse_net; with both, bias2.
 nlohmann::json metricsJson(const metrics::Metrics& m, std::optional<double> variance, std::optional<double> noise);
+/// The checks `wedge compare` makes of a second image beside `first` (`--variance-from` beside
+/// the test, `--reference-noise-from` beside the reference), and the Python module's compare() of
+/// the same keywords: finite, and of `first`'s size, else an Error naming the file and the flag.
+void checkSecondImage(const Image3f& second, const std::string& secondName, const std::string& flag,
+                      const Image3f& first, const std::string& firstName);
 /// Writes JSON through a temporary file and a rename.
 void writeJsonFile(const std::string& path, const nlohmann::json& j);
 

@@ -63,8 +63,12 @@ def test_compare_splits_the_error_as_the_cli_does(cornell, tmp_path):
     # Either alone adds only its own keys; a second image of another size is the CLI's error.
     assert "variance" not in wedge.compare(images["a"], images["r1"], reference_noise_from=images["r2"])
     assert "reference_noise" not in wedge.compare(images["a"], images["r1"], variance_from=images["b"])
-    small = np.ones((4, 4, 3), np.float32)
-    assert "size mismatch" in error_of(wedge.compare, images["a"], images["r1"], reference_noise_from=small)
+    small = tmp_path / "small.pfm"
+    wedge.write_image(str(small), np.ones((4, 4, 3), np.float32))
+    for keyword, flag in (("variance_from", "--variance-from"), ("reference_noise_from", "--reference-noise-from")):
+        message = error_of(wedge.compare, path["a"], path["r1"], **{keyword: str(small)})
+        assert message == cli_error("compare", path["a"], path["r1"], flag, small)
+        assert message.startswith(f"{small}: {flag}: image size 4x4 differs from")
 
 
 def test_read_image_and_buffers_give_back_what_was_written(cornell, tmp_path):
