@@ -550,6 +550,53 @@ TEST(Layers, ConsecutiveSharpLayersMergeAndTheImageStaysTheSame) {
     }
 }
 
+TEST(Layers, SharpLayersDoNotMergeAcrossAMovingLayerBetweenThem) {
+    // A still post in front (slope +1.2 px), a band moving 30 px over the shutter behind it
+    // (+0.4 px) and a still wall behind both (-0.4 px): the post and the wall are sharp layers
+    // that would merge (ConsecutiveSharpLayersMergeAndTheImageStaysTheSame), but the band lies
+    // between them in depth, and merged they composited as one layer in front of it: the wall
+    // showed through the band: a column's mean 0.34 off. (Found on a moving bunny over a floor
+    // that falls away from the focal plane: +7% over 35 x 15 pixels.) Kept apart, 0.009. Each
+    // column's mean against the exact shutter average (the lens moves the layers by under half
+    // a pixel here).
+    const int W = 128, H = 32, spp = 16;
+    const ViewGeometry view = wideLensView(W, H);
+    const float post = 1.f / 0.62f, band = 1.f / 0.54f, wall = 1.f / 0.46f;
+    ASSERT_NEAR(view.defocusSlope(post), 1.2f, 1e-4f);
+    ASSERT_NEAR(view.defocusSlope(band), 0.4f, 1e-4f);
+    ASSERT_NEAR(view.defocusSlope(wall), -0.4f, 1e-4f);
+    const float motion = 30.f;
+    auto inPost = [](float fx) { return fx >= 56.f && fx < 72.f; };
+    auto inBand = [&](float fx, float t) { return fx >= 30.f + motion * (t - 0.5f) && fx < 60.f + motion * (t - 0.5f); };
+    auto value = [&](float fx, float t) { return inPost(fx) ? 0.2 : inBand(fx, t) ? 1.0 : 0.5; };
+    LightFieldSamples lf(W, H);
+    const int stage = lf.addStage([&](size_t) { return uint32_t(spp); });
+    std::mt19937 rng(17);
+    std::uniform_real_distribution<float> uni(0.f, 1.f);
+    for (int y = 0; y < H; ++y)
+        for (int x = 0; x < W; ++x) {
+            LightFieldSample* run = lf.run(stage, size_t(y) * W + x);
+            for (int k = 0; k < spp; ++k) {
+                const Vec2f film{uni(rng), uni(rng)};
+                const float t = uni(rng), fx = float(x) + film.x;
+                const float depth = inPost(fx) ? post : inBand(fx, t) ? band : wall;
+                const Vec2f m = depth == band ? Vec2f{motion, 0.f} : Vec2f{0.f, 0.f};
+                run[k] = LightFieldSample::pack(film, concentricDisc(uni(rng), uni(rng)), t, depth, m, Vec3f(1.f),
+                                                Vec3f(float(value(fx, t))), 0);
+            }
+        }
+    const Image3f out = filter::reconstructLayers(filter::LayerInput{lf, view, {}});
+    double worst = 0;
+    int worstX = -1;
+    for (int x = 2; x < W - 2; ++x) {
+        double exact = 0, column = 0;
+        for (int y = 0; y < H; ++y) column += out(x, y).x / H;
+        for (int k = 0; k < 256; ++k) exact += value(float(x) + (float(k % 16) + 0.5f) / 16.f, (float(k / 16) + 0.5f) / 16.f) / 256.0;
+        if (std::abs(column - exact) > worst) worst = std::abs(column - exact), worstX = x;
+    }
+    EXPECT_LT(worst, 0.03) << "column " << worstX << ": the largest difference of a column's mean from the shutter average";
+}
+
 namespace {
 
 /// A pinhole light field of w x h pixels, 32 samples each at uniform random film positions and
