@@ -191,8 +191,9 @@ TEST(Layers, WhereAFilteredLightIsAnotherPointsASampleCarriesItsOwn) {
     // another surface than its pixel's primary one carries its own light (its filtered light is
     // a neighbour's), and so do the primary surface's samples of a pixel that saw several
     // surfaces where the layer's slope is at least 2 px, and every sample where it is at least
-    // 8 px (the filtered light would blur twice); everywhere else, the filtered light:
-    // in a sharp (in focus) layer, in a moving one (its light split over the shutter's bins).
+    // 8 px (the filtered light would blur twice); everywhere else, the filtered light: in a
+    // sharp (in focus) layer, and on the primary surface in a moving one (its light split over
+    // the shutter's bins), whose samples on other surfaces carry their own as a still layer's.
     const int W = 64, H = 64;
     const ViewGeometry view = wideLensView(W, H);
     Image3f primaryLight(W, H), otherLight(W, H);
@@ -230,9 +231,11 @@ TEST(Layers, WhereAFilteredLightIsAnotherPointsASampleCarriesItsOwn) {
     EXPECT_NEAR(reconstruct(slightly, {0, 0}, 1, 0), (15 * 0.2 + 0.5) / 16, 2e-3);
     EXPECT_NEAR(reconstruct(inFocus, {0, 0}, 1, 1), 0.9, 1e-4);
     EXPECT_NEAR(reconstruct(inFocus, {0, 0}, 1, 0), (15 * 0.2 + 0.9) / 16, 2e-3);
-    EXPECT_NEAR(reconstruct(inFocus, {12, 0}, 1, 1), 0.9, 1e-4);
-    EXPECT_NEAR(reconstruct(defocused, {12, 0}, 1, 1), 0.9, 1e-4);
-    EXPECT_NEAR(reconstruct(defocused, {12, 0}, 1, 0), (15 * 0.2 + 0.9) / 16, 2e-3);
+    EXPECT_NEAR(reconstruct(inFocus, {12, 0}, 1, 1), 0.5, 1e-4);
+    EXPECT_NEAR(reconstruct(defocused, {12, 0}, 1, 1), 0.5, 1e-4);
+    EXPECT_NEAR(reconstruct(defocused, {12, 0}, 1, 0), (15 * 0.2 + 0.5) / 16, 2e-3);
+    EXPECT_NEAR(reconstruct(defocused, {12, 0}, 0, 0), 0.2, 1e-4);
+    EXPECT_NEAR(reconstruct(farOff, {12, 0}, 0, 0), 0.2, 1e-4);
 }
 
 TEST(Layers, OnlyPixelsWhoseRaysStraddleLayersTakeTheExtraRays) {

@@ -893,7 +893,16 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                 // - anywhere the slope is at least kOwnLightAll (the pixel's filtered light,
                 //   already a mean over its circle of confusion, would be blurred again).
                 // The layer's grid and the rays' disc average the own light over many samples.
-                // A moving layer keeps the filtered light: its radiance is split over 8 time bins.
+                // In a blurred moving layer only the first. On another surface than its pixel's
+                // primary one, the neighbour whose filtered light a sample would carry is as far
+                // away as the motion: AAF relMSE -21% on a moving bunny over a floor (384x384),
+                // -11.5% / -8.5% on raster-cornell without and with its textures, -3.6% on
+                // docs/motion.json, -3.7% / -0.3% on raster-pan, +7.5% / +2.7% on
+                // raster-motion-defocus (its moving sphere's smooth light). On the primary
+                // surface it keeps the filtered light: its radiance is split over 8 time bins,
+                // and there the own light (the two slope rules as for a still layer) gained
+                // nothing on the bunny and cost +10% on raster-motion-defocus without textures
+                // (docs/layers.md, "Own light on a moving layer's other surfaces").
                 // Measured, AAF at 512x512, 16 spp, relMSE with layers before -> after: conference
                 // 0.000588 -> 0.000485, sponza 0.000656 -> 0.000586, bunny 0.000112 -> 0.000103,
                 // cornell-sphere 0.000129 -> 0.000124, cornell 0.0000709 -> 0.0000712; the held-out
@@ -903,8 +912,8 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                 // "Every sample its own light where the blur is large".
                 auto radianceOf = [&](const Gathered& s, const auto& l) {  // l: a Layer, or its SplatTarget
                     const float c = std::abs(l.c);
-                    const bool own = !l.sharp && !l.moving &&
-                                     (s.surface > 0 || (s.surface == 0 && (c >= kOwnLightAll || (mixed[s.pixel] && c >= kOwnLightSlope))));
+                    const bool own = !l.sharp && (s.surface > 0 || (!l.moving && s.surface == 0 &&
+                                                                    (c >= kOwnLightAll || (mixed[s.pixel] && c >= kOwnLightSlope))));
                     const Image3f* light = s.surface >= 0 && !own ? in.surfaceLight[s.surface] : nullptr;
                     return light ? unpackRgb9e5(s.albedo) * (*light)[s.pixel] : unpackRgb9e5(s.radiance);
                 };
