@@ -52,11 +52,12 @@
 //
 // The radiance a sample carries is its surface's light as the method filtered it (AAF's or
 // MAAF's filtered direct and indirect light of the sample's surface in its pixel, times the
-// sample's own albedo) or, without filtered light, its own. In a blurred still layer it carries
-// its own light also where the filtered light is another point's: a surface other than its
-// pixel's primary one (whose filtered light is a neighbour pixel's), and the primary surface of a
-// pixel that saw several, where the layer's slope is at least 2 px; and every sample where the
-// slope is at least 8 px, where the filtered light would blur twice (layers.cpp, radianceOf).
+// sample's own albedo) or, without filtered light, its own. In a blurred layer it carries its
+// own light also where the filtered light is another point's: on a surface other than its
+// pixel's primary one (whose filtered light is a neighbour pixel's; still or moving), and, in a
+// still layer, on the primary surface of a pixel that saw several, where the layer's slope is
+// at least 2 px, and wherever the slope is at least 8 px, where the filtered light would blur
+// twice (layers.cpp, radianceOf).
 // Emitted light is not reconstructed here: the caller adds each pixel's own (densely sampled at
 // emitter edges).
 #pragma once
