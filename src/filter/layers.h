@@ -48,7 +48,10 @@
 //    own samples composited by surface, as without layers. A pixel whose 32 rays straddle
 //    layers (ended on different ones, or on a layer's partial coverage: a defocused or moving
 //    silhouette) takes the sequence on to 64 rays: there the rays' own noise was a tenth of
-//    the error (MC 16 spp on bunny at 512x512: the mixed pixels' relMSE 0.00136 -> 0.00121).
+//    the error (MC 16 spp on bunny at 512x512: the mixed pixels' relMSE 0.00136 -> 0.00121);
+//    to LayerOptions::movingRays in a tile where a layer moves, whose rays integrate over the
+//    shutter as well (the renderer: 128 where the samples carry filtered light, AAF relMSE
+//    3-19% lower on eight scenes with motion; docs/layers.md, "More rays where a layer moves").
 //
 // The radiance a sample carries is its surface's light as the method filtered it (AAF's or
 // MAAF's filtered direct and indirect light of the sample's surface in its pixel, times the
@@ -97,7 +100,8 @@ struct LayerOptions {
     int maxLayers = 16;
     bool mergeSharp = true;
     int rays = 32;      // reconstruction rays per pixel where a tile has a blurred layer (at most 64)
-    int mixedRays = 64; // ... where the first `rays` straddle layers (at most 64)
+    int mixedRays = 64; // ... where the first `rays` straddle layers (at most 128)
+    int movingRays = 128;  // ... and a layer of the tile moves (at most 128; the renderer keeps mixedRays for MC)
     uint32_t seed = 0;  // of the reconstruction rays
 };
 
