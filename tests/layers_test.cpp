@@ -553,6 +553,45 @@ TEST(Layers, ConsecutiveSharpLayersMergeAndTheImageStaysTheSame) {
     }
 }
 
+namespace {
+
+/// A pinhole view of w x h pixels, focal length 100 px.
+ViewGeometry pinholeView(int w, int h) {
+    ViewGeometry view;
+    view.width = w;
+    view.height = h;
+    view.focalPixels = 100;
+    return view;
+}
+
+/// A light field of w x h pixels, `spp` samples each at uniform random film positions and
+/// shutter times (std::mt19937 `seed`), sample(x, y, film, t) -> LightFieldSample; with kLens,
+/// also lens points uniform on the disc, drawn after the time: sample(x, y, film, t, lens).
+template <bool kLens = false, class SampleFn>
+LightFieldSamples randomLightField(int w, int h, uint32_t spp, uint32_t seed, SampleFn&& sample) {
+    LightFieldSamples lf(w, h);
+    const int stage = lf.addStage([&](size_t) { return spp; });
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<float> uni(0.f, 1.f);
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+            LightFieldSample* run = lf.run(stage, size_t(y) * w + x);
+            for (uint32_t k = 0; k < spp; ++k) {
+                const Vec2f film{uni(rng), uni(rng)};
+                const float t = uni(rng);
+                if constexpr (kLens) {
+                    const Vec2f lens = concentricDisc(uni(rng), uni(rng));
+                    run[k] = sample(x, y, film, t, lens);
+                } else {
+                    run[k] = sample(x, y, film, t);
+                }
+            }
+        }
+    return lf;
+}
+
+}  // namespace
+
 TEST(Layers, SharpLayersDoNotMergeAcrossAMovingLayerBetweenThem) {
     // A still post in front (slope +1.2 px), a band moving 30 px over the shutter behind it
     // (+0.4 px) and a still wall behind both (-0.4 px): the post and the wall are sharp layers
@@ -572,22 +611,12 @@ TEST(Layers, SharpLayersDoNotMergeAcrossAMovingLayerBetweenThem) {
     auto inPost = [](float fx) { return fx >= 56.f && fx < 72.f; };
     auto inBand = [&](float fx, float t) { return fx >= 30.f + motion * (t - 0.5f) && fx < 60.f + motion * (t - 0.5f); };
     auto value = [&](float fx, float t) { return inPost(fx) ? 0.2 : inBand(fx, t) ? 1.0 : 0.5; };
-    LightFieldSamples lf(W, H);
-    const int stage = lf.addStage([&](size_t) { return uint32_t(spp); });
-    std::mt19937 rng(17);
-    std::uniform_real_distribution<float> uni(0.f, 1.f);
-    for (int y = 0; y < H; ++y)
-        for (int x = 0; x < W; ++x) {
-            LightFieldSample* run = lf.run(stage, size_t(y) * W + x);
-            for (int k = 0; k < spp; ++k) {
-                const Vec2f film{uni(rng), uni(rng)};
-                const float t = uni(rng), fx = float(x) + film.x;
-                const float depth = inPost(fx) ? post : inBand(fx, t) ? band : wall;
-                const Vec2f m = depth == band ? Vec2f{motion, 0.f} : Vec2f{0.f, 0.f};
-                run[k] = LightFieldSample::pack(film, concentricDisc(uni(rng), uni(rng)), t, depth, m, Vec3f(1.f),
-                                                Vec3f(float(value(fx, t))), 0);
-            }
-        }
+    const LightFieldSamples lf = randomLightField<true>(W, H, spp, 17, [&](int x, int, Vec2f film, float t, Vec2f lens) {
+        const float fx = float(x) + film.x;
+        const float depth = inPost(fx) ? post : inBand(fx, t) ? band : wall;
+        const Vec2f m = depth == band ? Vec2f{motion, 0.f} : Vec2f{0.f, 0.f};
+        return LightFieldSample::pack(film, lens, t, depth, m, Vec3f(1.f), Vec3f(float(value(fx, t))), 0);
+    });
     const Image3f out = filter::reconstructLayers(filter::LayerInput{lf, view, {}});
     double worst = 0;
     int worstX = -1;
@@ -602,28 +631,11 @@ TEST(Layers, SharpLayersDoNotMergeAcrossAMovingLayerBetweenThem) {
 
 namespace {
 
-/// A pinhole light field of w x h pixels, 32 samples each at uniform random film positions and
-/// shutter times (std::mt19937 `seed`), sample(x, y, film, t) -> LightFieldSample, reconstructed.
+/// randomLightField with 32 samples a pixel, reconstructed under a pinhole.
 template <class SampleFn>
 Image3f reconstructRandom(int w, int h, uint32_t seed, SampleFn&& sample) {
-    ViewGeometry view;
-    view.width = w;
-    view.height = h;
-    view.focalPixels = 100;
-    LightFieldSamples lf(w, h);
-    const int stage = lf.addStage([](size_t) { return 32u; });
-    std::mt19937 rng(seed);
-    std::uniform_real_distribution<float> uni(0.f, 1.f);
-    for (int y = 0; y < h; ++y)
-        for (int x = 0; x < w; ++x) {
-            LightFieldSample* run = lf.run(stage, size_t(y) * w + x);
-            for (int k = 0; k < 32; ++k) {
-                const Vec2f film{uni(rng), uni(rng)};
-                const float t = uni(rng);
-                run[k] = sample(x, y, film, t);
-            }
-        }
-    return filter::reconstructLayers(filter::LayerInput{lf, view, {}});
+    const LightFieldSamples lf = randomLightField(w, h, 32, seed, sample);
+    return filter::reconstructLayers(filter::LayerInput{lf, pinholeView(w, h), {}});
 }
 
 /// The largest difference, over columns x0 .. w - x0 - 1, between a column's mean of `out`'s
@@ -703,28 +715,14 @@ TEST(Layers, WhereALayerMovesTheStraddlingPixelsTakeMoreRays) {
     const int W = 128, H = 48;
     const float cx = 64.f, cy = 24.f, R = 14.f;
     auto build = [&](float motion) {
-        LightFieldSamples lf(W, H);
-        const int stage = lf.addStage([](size_t) { return 16u; });
-        std::mt19937 rng(13);
-        std::uniform_real_distribution<float> uni(0.f, 1.f);
-        for (int y = 0; y < H; ++y)
-            for (int x = 0; x < W; ++x) {
-                LightFieldSample* run = lf.run(stage, size_t(y) * W + x);
-                for (int k = 0; k < 16; ++k) {
-                    const Vec2f film{uni(rng), uni(rng)};
-                    const float t = uni(rng);
-                    const float dx = float(x) + film.x - (cx + motion * (t - 0.5f)), dy = float(y) + film.y - cy;
-                    const bool in = dx * dx + dy * dy < R * R;
-                    run[k] = LightFieldSample::pack(film, {0.f, 0.f}, t, in ? 2.f : 8.f, Vec2f{in ? motion : 0.f, 0.f},
-                                                    Vec3f(1.f), Vec3f(in ? 1.f : 0.25f), 0);
-                }
-            }
-        return lf;
+        return randomLightField(W, H, 16, 13, [&](int x, int y, Vec2f film, float t) {
+            const float dx = float(x) + film.x - (cx + motion * (t - 0.5f)), dy = float(y) + film.y - cy;
+            const bool in = dx * dx + dy * dy < R * R;
+            return LightFieldSample::pack(film, {0.f, 0.f}, t, in ? 2.f : 8.f, Vec2f{in ? motion : 0.f, 0.f}, Vec3f(1.f),
+                                          Vec3f(in ? 1.f : 0.25f), 0);
+        });
     };
-    ViewGeometry view;
-    view.width = W;
-    view.height = H;
-    view.focalPixels = 100;
+    const ViewGeometry view = pinholeView(W, H);
     auto noise = [&](const LightFieldSamples& lf, int movingRays) {
         filter::LayerOptions a, b;
         a.movingRays = b.movingRays = movingRays;
