@@ -99,7 +99,7 @@ struct LayerOptions {
     // layer budget".)
     int maxLayers = 16;
     bool mergeSharp = true;
-    int rays = 32;      // reconstruction rays per pixel where a tile has a blurred layer (at most 64)
+    int rays = 32;      // reconstruction rays per pixel where a tile has a blurred layer (at most 128)
     int mixedRays = 64; // ... where the first `rays` straddle layers (at most 128)
     int movingRays = 128;  // ... and a layer of the tile moves (at most 128; the renderer keeps mixedRays for MC)
     uint32_t seed = 0;  // of the reconstruction rays
