@@ -318,14 +318,13 @@ int mergeSharpRuns(Split::Histogram& h, int nLayers, const LayerOptions& o, cons
         const double inv = 1.0 / std::max(1, s.count);
         const float mx = float(s.sumMx * inv), my = float(s.sumMy * inv);
         const bool sharp = isSharp(float(s.sumC * inv), s.cMax - s.cMin, std::sqrt(mx * mx + my * my), o);
-        bool between = false;  // a moving layer's slope within the run extended by this layer
-        if (sharp && previousSharp) {
-            const float lo = std::min(runLo, s.cMin), hi = std::max(runHi, s.cMax);
-            for (int m = 0; m < movingCount; ++m) between |= !moving[m].empty() && moving[m].lo <= hi && moving[m].hi >= lo;
-        }
+        // The run's slopes extended by this layer, and whether a moving layer's fall within them.
+        const float lo = std::min(runLo, s.cMin), hi = std::max(runHi, s.cMax);
+        bool between = false;
+        for (int m = 0; m < movingCount; ++m) between |= !moving[m].empty() && moving[m].lo <= hi && moving[m].hi >= lo;
         if (sharp && previousSharp && !between) {
             run.back() = 1;
-            runLo = std::min(runLo, s.cMin), runHi = std::max(runHi, s.cMax);
+            runLo = lo, runHi = hi;
         } else {
             ++merged;
             run.push_back(0);
@@ -448,7 +447,8 @@ void splitLayers(Samples& g, const SlopeRange (&range)[kClasses], const LayerOpt
         l.my = float(l.sumMy * inv);
         l.invDepth = float(l.sumInvDepth * inv);
     }
-    // Front to back: by mean inverse depth (a miss is at 0), which orders layers of any slope.
+    // Front to back: by mean inverse depth (a miss is at 0), which orders layers of any slope; a
+    // moving layer by its nearest sample's (below).
     std::vector<int> order(layers.size());
     for (size_t i = 0; i < order.size(); ++i) order[i] = int(i);
     // A moving layer by its nearest sample: where it and a still layer overlap in depth (an
