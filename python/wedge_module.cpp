@@ -250,7 +250,7 @@ PYBIND11_MODULE(wedge, m) {
           "Renders a Scene as `wedge render` does. Every keyword is optional and is one of `wedge render`'s "
           "flags with underscores for dashes: method ('mc', 'aaf', 'maaf', 'atrous'), spp, seed, resolution "
           "((W, H) or 'WxH'), threads (0: all cores), quiet, aov, max_extra_spp, maaf_components, "
-          "maaf_paper_rates, no_focal_fallback, ... (`wedge render --help` lists them all); None keeps the "
+          "maaf_paper_rates, no_focal_fallback, sampler, ... (`wedge render --help` lists them all); None keeps the "
           "default. The same scene, method, seed and resolution give the CLI's image bit for bit, whatever "
           "the thread count. The GIL is released while rendering; Ctrl-C stops the render with "
           "KeyboardInterrupt. Raises wedge.Error with the CLI's message on bad input.");

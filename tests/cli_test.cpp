@@ -394,6 +394,8 @@ TEST(Cli, BadFlags) {
     EXPECT_EQ(runWedge("render " + g + "--method maaf --maaf-radius 129", nullptr, &err), 2) << err;
     EXPECT_EQ(runWedge("render " + g + "--method maaf --maaf-components 2", nullptr, &err), 2) << err;
     EXPECT_NE(err.find("--maaf-components"), std::string::npos) << err;
+    EXPECT_EQ(runWedge("render " + g + "--sampler halton", nullptr, &err), 2) << err;
+    EXPECT_NE(err.find("--sampler"), std::string::npos) << err;
     EXPECT_EQ(runWedge("render " + g + "--resolution 12by3", nullptr, &err), 2) << err;
     EXPECT_NE(err.find("--resolution"), std::string::npos) << err;
     EXPECT_EQ(runWedge("render " + g + "-o " + dir + "/x.jpg", nullptr, &err), 2) << err;

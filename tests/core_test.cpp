@@ -1,6 +1,8 @@
 // Core and I/O: the per-pixel sample generator's stratification and determinism, and image
 // files written and read back (EXR with named channels, PFM orientation, PNG sRGB, JPEG texture maps).
 #include <gtest/gtest.h>
+
+#include <algorithm>
 #include <zlib.h>
 
 #include <array>
@@ -116,6 +118,45 @@ TEST(Sampler, DependsOnlyOnSeedPixelIndexAndPair) {
     EXPECT_NE(a.get2D(7, 2).x, d.get2D(7, 2).x);
     EXPECT_NE(a.get2D(7, 2).x, a.get2D(7, 3).x);
     EXPECT_EQ(reverseBits32(sobol1Reversed(12345)), sobol1(12345));
+}
+
+TEST(Sampler, IndependentPointsAreUniformAndNotStratified) {
+    // --sampler independent: uniform in [0, 1)^2 (moments over 4096 points: the means' standard
+    // error is 0.0045), the batches and get4D's first half the same points as get2D, and a
+    // pixel's 16 points only by chance one in each of 16 strata (Sobol's always are: above;
+    // independent ones with probability 16! / 16^16, about 1e-6).
+    double sx = 0, sy = 0, sxx = 0, sxy = 0;
+    int stratified = 0;
+    for (uint32_t pixel = 0; pixel < 256; ++pixel) {
+        PixelSampler s(17, pixel, true);
+        ASSERT_TRUE(s.independent());
+        Vec2f batch[16], a[16], b[16];
+        s.get2DBatch(0, 16, 2, batch);
+        s.get4DBatch(0, 16, 0, a, b);
+        int strata[16] = {};
+        for (uint32_t i = 0; i < 16; ++i) {
+            const Vec2f v = s.get2D(i, 2);
+            ASSERT_EQ(v.x, batch[i].x);
+            ASSERT_EQ(v.y, batch[i].y);
+            ASSERT_EQ(s.get2D(i, 0).x, a[i].x);
+            ASSERT_NE(a[i].x, b[i].x);
+            ASSERT_GE(v.x, 0.f);
+            ASSERT_LT(v.x, 1.f);
+            ASSERT_GE(v.y, 0.f);
+            ASSERT_LT(v.y, 1.f);
+            sx += v.x, sy += v.y, sxx += double(v.x) * v.x, sxy += double(v.x) * v.y;
+            ++strata[int(v.x * 16)];
+        }
+        stratified += std::all_of(strata, strata + 16, [](int c) { return c == 1; }) ? 1 : 0;
+        // Not the Sobol points of the same seed and pixel.
+        EXPECT_NE(s.get2D(3, 2).x, PixelSampler(17, pixel).get2D(3, 2).x);
+    }
+    const double n = 4096;
+    EXPECT_NEAR(sx / n, 0.5, 0.02);
+    EXPECT_NEAR(sy / n, 0.5, 0.02);
+    EXPECT_NEAR(sxx / n - sqr(sx / n), 1.0 / 12, 0.01);
+    EXPECT_NEAR(sxy / n - (sx / n) * (sy / n), 0.0, 0.01);  // the two dimensions uncorrelated
+    EXPECT_EQ(stratified, 0);
 }
 
 // A cancellation request stops the parallel loops and the progress counters, which every stage of

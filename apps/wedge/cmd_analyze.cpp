@@ -243,20 +243,32 @@ void runPenumbra(PenumbraArgs a) {
                 s.lightHalfLength, s.lightHalfLength, s.lightAspect, s.slope, width,
                 s.filterSMin > 0 ? s.filterSMin : s.slope, s.filterSMax > 0 ? s.filterSMax : s.slope, a.weights.c_str(),
                 s.spatialScale, s.window > 0 ? std::to_string(s.window).c_str() : "unbounded");
-    std::printf("%-11s %10s %10s %12s %26s\n", "components", "RMS bias", "hardness", "variance", "beats K=1 below (samples");
-    std::printf("%-11s %10s %10s %12s %26s\n", "", "", "(>0 hard)", "(x K=1)", "per penumbra width)");
+    const bool stratified = s.spp > 0;
+    if (stratified)
+        std::printf("samples: %d per pixel of width %g (%.1f pixels across the penumbra), stratified along the light\n", s.spp,
+                    s.pixelWidth, width / s.pixelWidth);
+    else
+        std::printf("samples: independent (a Poisson process in x, light points from the whole light)\n");
+    std::printf("%-11s %10s %10s %12s %26s", "components", "RMS bias", "hardness", "variance", "beats K=1 below (samples");
+    if (stratified) std::printf(" %12s %13s", "variance", "stratified /");
+    std::printf("\n%-11s %10s %10s %12s %26s", "", "", "(>0 hard)", "(x K=1)", "per penumbra width)");
+    if (stratified) std::printf(" %12s %13s", "rho Var", "independent");
+    std::printf("\n");
     for (const auto& r : rs) {
         double rho = breakEvenDensity(r, rs[0]);
         char beats[64];
         if (r.components == 1) std::snprintf(beats, sizeof beats, "-");
         else if (std::isinf(rho)) std::snprintf(beats, sizeof beats, "always");
         else if (rho <= 0) std::snprintf(beats, sizeof beats, "never");
+        else if (stratified) std::snprintf(beats, sizeof beats, "%.0f (%.2g rows)", rho * width, rho * s.pixelWidth / s.spp);
         else std::snprintf(beats, sizeof beats, "%.0f", rho * width);
-        std::printf("%-11d %10.4f %+10.4f %12.3f %26s\n", r.components, r.rmsBias, r.hardness,
-                    r.variance / rs[0].variance, beats);
+        std::printf("%-11d %10.4f %+10.4f %12.3f %26s", r.components, r.rmsBias, r.hardness, r.variance / rs[0].variance, beats);
+        if (stratified) std::printf(" %12.4g %13.3f", r.variance, r.variance / r.varianceIndependent);
+        std::printf("\n");
     }
     std::printf("(mean squared error at a sample density rho = bias^2 + variance / rho; expectation and variance of "
-                "the ratio estimator by quadrature, docs/analysis.md)\n");
+                "the ratio estimator by quadrature, docs/analysis.md%s)\n",
+                stratified ? "; with --spp, rho is spp / pixel width times the rows a 2D filter averages along the edge" : "");
 
     if (!a.csv.empty()) {
         std::ostringstream csv;
@@ -362,6 +374,9 @@ void registerAnalyze(CLI::App& app) {
     pe->add_option("--spatial-scale", pa->setup.spatialScale, "Fourier std of the spatial Gaussians / eq. 8's half-width (default sqrt 6, the renderer's)");
     pe->add_option("--window", pa->setup.window, "Cut the filter at |x - x'| <= this (default 0: unbounded)");
     pe->add_option("--points", pa->setup.points, "Output positions across the penumbra (default 61)");
+    pe->add_option("--spp", pa->setup.spp,
+                   "Samples per pixel, stratified along the light as the renderer's Sobol points (default 0: independent samples)");
+    pe->add_option("--pixel-width", pa->setup.pixelWidth, "The pixel's width in x, with --spp");
     pe->add_option("-o,--output", pa->output, "PNG plot of the expected edge profiles");
     pe->add_option("--csv", pa->csv, "CSV of the expected edge profiles");
     pe->callback([pa] { runPenumbra(*pa); });

@@ -78,6 +78,10 @@ void addMethodFlags(CLI::App& cmd, render::RenderOptions& r) {
         ->check(numberIn(1e-6, 1e6));
     cmd.add_flag("!--no-variance", r.atrousVarianceGuided,
                  "atrous: plain colour edge-stopping instead of variance-guided (SVGF-style)");
+    cmd.add_option("--sampler", r.sampler,
+                   "The path samples' numbers: sobol (default: Owen-scrambled Sobol points, stratified per pixel) or "
+                   "independent (independent uniform numbers, to measure what the stratification is worth)")
+        ->check(CLI::IsMember({"sobol", "independent"}));
     cmd.add_option("--layers", r.layers,
                    "auto (default: on for mc and atrous up to 64 spp, off for aaf and maaf), on: the layered reconstruction of "
                    "defocus and motion blur across pixels, off: each pixel's own samples (and aaf's and maaf's defocus filter)")

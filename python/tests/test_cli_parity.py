@@ -112,6 +112,7 @@ BAD_OPTIONS = [
     (dict(sigma_color=float("nan")), ["--sigma-color", "nan"]),
     (dict(aov="/nonexistent/dir"), ["--aov", "/nonexistent/dir"]),
     (dict(layers="sometimes"), ["--layers", "sometimes"]),
+    (dict(sampler="halton"), ["--sampler", "halton"]),
     (dict(no_such_option=1), ["--no-such-option=1"]),
 ]
 

@@ -23,9 +23,20 @@ void validatePenumbra(const PenumbraSetup& s) {
     if (s.filterSMin > s.filterSMax) throw Error("--smin/--smax", "expected smin <= smax");
     if (s.window < 0 || !std::isfinite(s.window)) throw Error("--window", "expected 0 (unbounded) or a positive width");
     if (s.points < 3 || s.points > 10001) throw Error("--points", "expected 3 to 10001 positions");
+    if (s.spp < 0 || s.spp > 4096) throw Error("--spp", "expected 0 (independent samples) to 4096 samples per pixel");
+    if (s.spp > 0 && (!(s.pixelWidth > 0) || !std::isfinite(s.pixelWidth)))
+        throw Error("--pixel-width", "expected a positive pixel width with --spp");
+    if (s.spp == 0 && s.pixelWidth != 0) throw Error("--pixel-width", "only with --spp (the stratified samples' pixels)");
 }
 
-PenumbraResponse penumbraResponse(int pairs, const PenumbraSetup& set) {
+double PenumbraKernel::operator()(double a, double y) const {
+    if (std::abs(a) > reach) return 0;
+    double k = 0;
+    for (const Term& t : terms) k += t.weight * t.sx * std::exp(-0.5 * t.sx * t.sx * a * a) * std::cos(t.cx * a - t.cy * y);
+    return k;
+}
+
+PenumbraKernel penumbraKernel(int pairs, const PenumbraSetup& set) {
     validatePenumbra(set);
     if (pairs < 1 || pairs > filter::kMaafMaxPairs) throw Error("pairs", "expected 1 to " + std::to_string(filter::kMaafMaxPairs));
     const double L = set.lightHalfLength, s = set.slope;
@@ -36,16 +47,81 @@ PenumbraResponse penumbraResponse(int pairs, const PenumbraSetup& set) {
     w.omegaYMax = omegaY;
     w.sMin = set.filterSMin > 0 ? set.filterSMin : s;
     w.sMax = set.filterSMax > 0 ? set.filterSMax : s;
-    const std::vector<filter::MaafComponent> comps = filter::maafComponents(pairs, w);
-
-    // Kernel k(a, y) on a grid of offsets a (midpoints, symmetric about 0) and light positions y.
-    double sxMin = std::numeric_limits<double>::infinity(), sxMax = 0, cxMax = 0;
-    for (const auto& c : comps) {
+    PenumbraKernel kernel;
+    double sxMin = std::numeric_limits<double>::infinity();
+    for (const auto& c : filter::maafComponents(pairs, w)) {
+        // The renderer's mu_p for a light 2L long seen along its length.
+        const double mu = filter::componentWeight(c, set.weights, [&] { return filter::parallelogramSpectrum(c.cy, 2 * L, 0); });
+        kernel.terms.push_back({(c.p == 0 ? 1.0 : 2.0) * mu, c.sx * set.spatialScale, c.cx, c.cy});
         sxMin = std::min(sxMin, c.sx * set.spatialScale);
-        sxMax = std::max(sxMax, c.sx * set.spatialScale);
-        cxMax = std::max(cxMax, std::abs(c.cx));
     }
-    const double reach = set.window > 0 ? set.window : 8.0 / sxMin;  // primal std of a component: 1 / (its sx)
+    kernel.reach = set.window > 0 ? set.window : 8.0 / sxMin;  // primal std of a component: 1 / (its sx)
+    return kernel;
+}
+
+namespace {
+
+/// rho Var(sum_i k_i (v_i - m)) with the samples stratified: the sum over the cells (a pixel of
+/// width D, one of the spp strata of the light) of the variance of k (v - m) within the cell,
+/// times rho = spp / D (so that it is the same quantity as E[k^2 (v - m)^2], the independent
+/// samples'). By midpoint quadrature in each cell: kQx positions in the pixel, enough light
+/// positions per stratum for 512 over the light.
+double stratifiedVariance(const PenumbraKernel& kernel, const PenumbraSetup& set, double x, double m) {
+    constexpr int kQx = 16;
+    const int n = set.spp, qy = std::max(4, 512 / n);
+    const double D = set.pixelWidth, L = set.lightHalfLength, s = set.slope, stratum = 2 * L / n;
+    // cos(C_x a - C_y y) = cos(C_x a) cos(C_y y) + sin(C_x a) sin(C_y y): the y factors per light
+    // position, the a factors (with the Gaussian) per position in the pixel.
+    const size_t terms = kernel.terms.size();
+    std::vector<double> cy(size_t(n) * qy * terms), sy(cy.size()), ys(size_t(n) * qy);
+    for (int i = 0; i < n * qy; ++i) {
+        ys[i] = -L + (i + 0.5) * (stratum / qy);
+        for (size_t t = 0; t < terms; ++t) {
+            cy[size_t(i) * terms + t] = std::cos(kernel.terms[t].cy * ys[i]);
+            sy[size_t(i) * terms + t] = std::sin(kernel.terms[t].cy * ys[i]);
+        }
+    }
+    std::vector<double> ca(terms), sa(terms), sumZ(n), sumZ2(n);
+    double total = 0;
+    const long p0 = long(std::floor((x - kernel.reach) / D)), p1 = long(std::floor((x + kernel.reach) / D));
+    for (long p = p0; p <= p1; ++p) {
+        std::fill(sumZ.begin(), sumZ.end(), 0.0);
+        std::fill(sumZ2.begin(), sumZ2.end(), 0.0);
+        for (int u = 0; u < kQx; ++u) {
+            const double xs = (double(p) + (u + 0.5) / kQx) * D, a = x - xs;
+            if (std::abs(a) > kernel.reach) continue;  // k = 0 there
+            for (size_t t = 0; t < terms; ++t) {
+                const auto& term = kernel.terms[t];
+                const double g = term.weight * term.sx * std::exp(-0.5 * term.sx * term.sx * a * a);
+                ca[t] = g * std::cos(term.cx * a);
+                sa[t] = g * std::sin(term.cx * a);
+            }
+            for (int i = 0; i < n * qy; ++i) {
+                double k = 0;
+                for (size_t t = 0; t < terms; ++t) k += ca[t] * cy[size_t(i) * terms + t] + sa[t] * sy[size_t(i) * terms + t];
+                const double z = k * ((xs + s * ys[i] > 0 ? 1.0 : 0.0) - m);
+                sumZ[size_t(i / qy)] += z;
+                sumZ2[size_t(i / qy)] += z * z;
+            }
+        }
+        const double q = double(kQx) * qy;
+        for (int j = 0; j < n; ++j) total += std::max(0.0, sumZ2[j] / q - (sumZ[j] / q) * (sumZ[j] / q));
+    }
+    return total * D / n;  // rho Var(sum) / rho^2 = sum_cells Var_cell / rho, rho = spp / D
+}
+
+}  // namespace
+
+PenumbraResponse penumbraResponse(int pairs, const PenumbraSetup& set) {
+    const PenumbraKernel kernel = penumbraKernel(pairs, set);
+    const double L = set.lightHalfLength, s = set.slope;
+    // Kernel k(a, y) on a grid of offsets a (midpoints, symmetric about 0) and light positions y.
+    double sxMax = 0, cxMax = 0;
+    for (const auto& t : kernel.terms) {
+        sxMax = std::max(sxMax, t.sx);
+        cxMax = std::max(cxMax, std::abs(t.cx));
+    }
+    const double reach = kernel.reach;
     double h = std::min(1.0 / (8 * sxMax), s * L / 100);
     if (cxMax > 0) h = std::min(h, 2 * M_PI / (24 * cxMax));
     const int na = 2 * int(std::ceil(reach / h)), ny = 256;
@@ -53,15 +129,8 @@ PenumbraResponse penumbraResponse(int pairs, const PenumbraSetup& set) {
     std::vector<double> a(na), y(ny), k(size_t(na) * ny);
     for (int j = 0; j < na; ++j) a[j] = -reach + (j + 0.5) * h;
     for (int i = 0; i < ny; ++i) y[i] = -L + (i + 0.5) * (2 * L / ny);
-    for (const auto& c : comps) {
-        // The renderer's mu_p for a light 2L long seen along its length.
-        const double mu = filter::componentWeight(c, set.weights, [&] { return filter::parallelogramSpectrum(c.cy, 2 * L, 0); });
-        const double weight = (c.p == 0 ? 1.0 : 2.0) * mu, sx = c.sx * set.spatialScale;
-        for (int j = 0; j < na; ++j) {
-            const double g = weight * sx * std::exp(-0.5 * sx * sx * a[j] * a[j]);  // unit integral up to 1/sqrt(2 pi)
-            for (int i = 0; i < ny; ++i) k[size_t(j) * ny + i] += g * std::cos(c.cx * a[j] - c.cy * y[i]);
-        }
-    }
+    for (int j = 0; j < na; ++j)
+        for (int i = 0; i < ny; ++i) k[size_t(j) * ny + i] = kernel(a[j], y[i]);
     double sumK = 0, sumK2 = 0;
     for (double v : k) {
         sumK += v;
@@ -89,7 +158,12 @@ PenumbraResponse penumbraResponse(int pairs, const PenumbraSetup& set) {
         const double truth = std::clamp((x / s + L) / (2 * L), 0.0, 1.0);
         // E[k^2 (v - m)^2] with v in {0, 1}: lit (1 - m)^2 + unlit m^2; the sums carry h / ny.
         const double e2 = litK2 * (1 - m) * (1 - m) + (sumK2 - litK2) * m * m;
-        variance += (e2 * h / ny) / ((sumK * h / ny) * (sumK * h / ny));
+        const double meanK = sumK * h / ny;  // E[k]
+        const double independent = (e2 * h / ny) / (meanK * meanK);
+        r.varianceIndependent += independent;
+        const double v = set.spp > 0 ? stratifiedVariance(kernel, set, x, m) / (meanK * meanK) : independent;
+        r.var.push_back(v);
+        variance += v;
         r.x.push_back(x);
         r.truth.push_back(truth);
         r.mean.push_back(m);
@@ -102,6 +176,7 @@ PenumbraResponse penumbraResponse(int pairs, const PenumbraSetup& set) {
     r.rmsBias = std::sqrt(bias2 / set.points);
     r.hardness = nHard > 0 ? hard / nHard : 0;
     r.variance = variance / set.points;
+    r.varianceIndependent /= set.points;
     return r;
 }
 

@@ -13,7 +13,15 @@
 //  - its expectation m(x) = E[k v] / E[k] (to first order in 1/n), against the exact penumbra
 //    (x / s + L) / (2 L) clamped to [0, 1];
 //  - its variance, rho Var = E[k^2 (v - m)^2] / E[k]^2 (the delta method), so that the mean
-//    squared error at density rho is bias^2 + variance / rho.
+//    squared error at density rho is bias^2 + variance / rho. That is the variance of
+//    independent samples (a Poisson process in x, y drawn from the whole light).
+//  - With `spp`, the variance of the renderer's samples instead: pixels of `pixelWidth` in x,
+//    each with spp samples stratified along the light (one in each of spp equal strata of y, x
+//    uniform in the pixel), as the renderer's Owen-scrambled Sobol points are in every
+//    elementary interval (core/sampler.h). The sum's variance is then the sum over the cells
+//    (pixel, stratum) of the variance within each cell, Var = sum_cells Var_cell(k (v - m)) /
+//    (sum E[k])^2, which for an edge is far below the independent samples': only the strata
+//    the edge crosses vary. (Stratification does not change the expectation.)
 // Hardness is the mean signed error over the penumbra's inner 96%, counted positive where the
 // filtered edge is steeper than the truth (above it in the lit half, below it in the dark half).
 #pragma once
@@ -35,14 +43,29 @@ struct PenumbraSetup {
     filter::MaafWeights weights = filter::MaafWeights::Sampling;
     double window = 0;             // |x - x'| <= window; 0: unbounded (8 std of the widest Gaussian)
     int points = 61;               // output positions across [-1.25 s L, 1.25 s L]
+    int spp = 0;                   // > 0: samples per pixel, stratified along the light; 0: independent samples
+    double pixelWidth = 0;         // the pixel's width in x (with spp)
 };
+
+/// The filter's kernel k(a, y) for N = `pairs` (2N - 1 components), zero beyond `reach`.
+struct PenumbraKernel {
+    struct Term {
+        double weight, sx, cx, cy;  // weight c_p mu_p, the Gaussian's Fourier std, the centre (C_x, C_y)
+    };
+    std::vector<Term> terms;
+    double reach = 0;  // |a| beyond which k = 0 (the window, or 8 std of the widest Gaussian)
+    double operator()(double a, double y) const;
+};
+PenumbraKernel penumbraKernel(int pairs, const PenumbraSetup& setup);
 
 struct PenumbraResponse {
     int components = 1;            // 2N - 1
     std::vector<double> x, truth, mean;  // per output position
     double rmsBias = 0;            // over all output positions
     double hardness = 0;           // see above
-    double variance = 0;           // mean of rho Var over the output positions
+    std::vector<double> var;       // rho Var per output position (stratified with spp)
+    double variance = 0;           // mean of rho Var over the output positions (stratified with spp)
+    double varianceIndependent = 0;  // ... of independent samples (= variance without spp)
 };
 
 /// Checks the setup; throws Error naming the field.
@@ -52,8 +75,9 @@ PenumbraResponse penumbraResponse(int pairs, const PenumbraSetup& setup);
 
 /// Sample density (per unit length of x) below which filter `a` has the lower mean squared error
 /// than `b` on average over the penumbra, given a's lower variance and higher bias: the root of
-/// bias_a^2 + V_a / rho = bias_b^2 + V_b / rho. Infinity when a is no more biased than b, 0 when
-/// it is not less noisy.
+/// bias_a^2 + V_a / rho = bias_b^2 + V_b / rho (the variances of the response: stratified with
+/// spp, where rho then counts the rows a 2D filter also averages along the edge). Infinity when a
+/// is no more biased than b, 0 when it is not less noisy.
 double breakEvenDensity(const PenumbraResponse& a, const PenumbraResponse& b);
 
 }  // namespace wedge::analysis

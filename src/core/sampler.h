@@ -110,19 +110,26 @@ inline float toUnitFloat(uint32_t x) {
 
 /// The sample generator for one pixel. Cheap to construct; holds no mutable state, so the same
 /// (pixel, index, pair) always yields the same point.
+///
+/// `independent`: independent uniform numbers instead (a hash of the pixel's key, the index,
+/// the pair and the dimension), with none of the stratification above: for measuring what the
+/// stratification is worth (`wedge render --sampler independent`; docs/maaf.md, "Stratified
+/// samples"). The same (seed, pixel, index, pair) still gives the same point.
 class PixelSampler {
 public:
     static constexpr uint32_t kPairs = 8;  // dimension pairs a path sample may use
 
-    PixelSampler(uint32_t seed, uint32_t pixelIndex) {
+    PixelSampler(uint32_t seed, uint32_t pixelIndex, bool independent = false) : m_independent(independent) {
         uint32_t key = hashCombine(hash32(seed), pixelIndex);
         for (uint32_t p = 0; p < kPairs; ++p) m_pairKey[p] = hashCombine(key, p);
     }
+    bool independent() const { return m_independent; }
 
     /// The 2D point of dimension pair `pair` (dimensions 2*pair and 2*pair+1) for sample `index`.
     /// nestedUniformScramble(sobol_d(i)) = reverse(laineKarras(reversed sobol_d(i))), and the
     /// reversed dimension 0 is the index itself.
     Vec2f get2D(uint32_t index, uint32_t pair) const {
+        if (m_independent) return uniform(index, pair, 0);
         const Keys key = keys(pair);
         uint32_t shuffled = nestedUniformScramble(index, key.shuffle);
         return {scrambled(shuffled, key.dim[0]), scrambled(sobol1Reversed(shuffled), key.dim[1])};
@@ -132,6 +139,10 @@ public:
     /// get2D for `count` (<= 16) consecutive indices at once, as flat loops over the 16 lanes
     /// that the compiler vectorises (one pixel's batch of samples).
     void get2DBatch(uint32_t first, uint32_t count, uint32_t pair, Vec2f* out) const {
+        if (m_independent) {
+            for (uint32_t k = 0; k < count; ++k) out[k] = uniform(first + k, pair, 0);
+            return;
+        }
         const Keys key = keys(pair);
         alignas(64) uint32_t sh[16], r[16];
         shuffleLanes(first, key.shuffle, sh);
@@ -144,6 +155,10 @@ public:
     /// shuffled index, so (a, b) is jointly stratified. Replaces pair `pair + 1`.
     void get4D(uint32_t index, uint32_t pair, Vec2f& a, Vec2f& b) const { get4DBatch(index, 1, pair, &a, &b); }
     void get4DBatch(uint32_t first, uint32_t count, uint32_t pair, Vec2f* outA, Vec2f* outB) const {
+        if (m_independent) {
+            for (uint32_t k = 0; k < count; ++k) outA[k] = uniform(first + k, pair, 0), outB[k] = uniform(first + k, pair, 1);
+            return;
+        }
         const Keys key = keys(pair);
         alignas(64) uint32_t sh[16], r1[16], r2[16], r3[16];
         shuffleLanes(first, key.shuffle, sh);
@@ -157,6 +172,12 @@ public:
     }
 
 private:
+    /// Two independent uniform numbers for sample `index` of pair `pair` (`half` 1: its
+    /// dimensions 2-3 in get4DBatch).
+    Vec2f uniform(uint32_t index, uint32_t pair, uint32_t half) const {
+        const uint32_t h = hashCombine(hashCombine(m_pairKey[pair % kPairs] ^ 0x68bc21ebU, index), half);
+        return {toUnitFloat(h), toUnitFloat(hash32(h ^ 0x5bd1e995U))};
+    }
     /// A pair's seeds: the index shuffle and one nested uniform scramble per Sobol dimension
     /// (dimensions 0-1 are the ones get2D uses).
     struct Keys {
@@ -182,6 +203,7 @@ private:
     static float scrambled(uint32_t reversed, uint32_t seed) { return toUnitFloat(reverseBits32(laineKarras(reversed, seed))); }
 
     uint32_t m_pairKey[kPairs];
+    bool m_independent = false;
 };
 
 }  // namespace wedge

@@ -260,7 +260,7 @@ void PathSampler::traceMany(const SampleRun* runs, size_t nRuns, bool span) cons
 
             // The batch's random numbers, pair by pair (vectorised across samples). Dimensions
             // that do not matter are not drawn (the others do not depend on it).
-            const PixelSampler rng(m_seed, uint32_t(run.y) * uint32_t(m_camera.width()) + uint32_t(run.x));
+            const PixelSampler rng(m_seed, uint32_t(run.y) * uint32_t(m_camera.width()) + uint32_t(run.x), m_independent);
             if (m_indirect) {
                 rng.get2DBatch(first, uint32_t(n), kBounce, w.uBounce + l0);
                 rng.get2DBatch(first, uint32_t(n), kBounceLight, w.uBounceLight + l0);
@@ -390,7 +390,7 @@ void PathSampler::traceMany(const SampleRun* runs, size_t nRuns, bool span) cons
 
 Vec3f PathSampler::meanEmission(int x, int y, uint32_t count) const {
     constexpr int K = scene::RayPacket::kSize;
-    const PixelSampler rng(m_seed, uint32_t(y) * uint32_t(m_camera.width()) + uint32_t(x));
+    const PixelSampler rng(m_seed, uint32_t(y) * uint32_t(m_camera.width()) + uint32_t(x), m_independent);
     Vec3f sum(0.f);
     for (uint32_t first = 0; first < count; first += K) {
         const int n = int(std::min<uint32_t>(K, count - first));
@@ -410,7 +410,7 @@ Vec3f PathSampler::meanEmission(int x, int y, uint32_t count) const {
 
 uint64_t PathSampler::primaryHits(int x, int y, uint32_t first, uint32_t count, TracedSample* out) const {
     constexpr int K = scene::RayPacket::kSize;
-    const PixelSampler rng(m_seed, uint32_t(y) * uint32_t(m_camera.width()) + uint32_t(x));
+    const PixelSampler rng(m_seed, uint32_t(y) * uint32_t(m_camera.width()) + uint32_t(x), m_independent);
     for (uint32_t done = 0; done < count; done += K) {
         const int n = int(std::min<uint32_t>(K, count - done));
         scene::RayPacket primary;

@@ -86,6 +86,10 @@ public:
 
     const Camera& camera() const { return m_camera; }
     uint32_t seed() const { return m_seed; }
+    /// Independent uniform numbers instead of the stratified Sobol points (PixelSampler;
+    /// `--sampler independent`).
+    void setIndependentSamples(bool independent) { m_independent = independent; }
+    bool independentSamples() const { return m_independent; }
     /// Over several ranks (render/distribution.h): this rank traces only its own rows, and the
     /// sampling stages copy what they computed to every rank. Null: one process, every row.
     void distribute(const Distribution* d, int rank, int ranks) {
@@ -139,6 +143,7 @@ private:
     Camera m_camera;
     bool m_indirect;
     uint32_t m_seed;
+    bool m_independent = false;
     float m_epsilon;
     bool m_needChoice;  // light choice or shutter time vary
     mutable std::atomic<uint64_t> m_nonFinite{0};

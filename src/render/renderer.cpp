@@ -233,6 +233,9 @@ RenderResult render(const scene::Scene& scene, const RenderOptions& options) {
     Timer total;
     Camera camera(desc.camera);
     PathSampler sampler(scene, camera, desc.render.indirect, seed);
+    if (options.sampler != "sobol" && options.sampler != "independent")
+        throw Error("--sampler", "expected sobol or independent, got '" + options.sampler + "'");
+    sampler.setIndependentSamples(options.sampler == "independent");
     if (const Distribution* d = options.distribution; d && d->ranks() > 1) sampler.distribute(d, d->rank(), d->ranks());
     LightFieldSamples lightField;
     if (options.layers != "auto" && options.layers != "on" && options.layers != "off")

@@ -63,6 +63,10 @@ struct RenderOptions {
     float atrousSigmaColor = 4.f, atrousSigmaNormal = 0.5f, atrousSigmaPosition = 1.f;
     bool atrousVarianceGuided = true;
     std::string aovDir;              // debug maps (PNG) when non-empty
+    // The path samples' numbers: "sobol" (Owen-scrambled Sobol points, stratified per pixel:
+    // core/sampler.h) or "independent" (independent uniform numbers, for measuring what the
+    // stratification is worth: docs/maaf.md, "Stratified samples").
+    std::string sampler = "sobol";
     // The layered reconstruction of defocus and motion blur across pixels (filter/layers.h),
     // where the camera has a lens or the scene moves: "on", "off" (each pixel composes its own
     // samples by surface, and aaf and maaf apply their defocus filter) or "auto", the measured
