@@ -520,6 +520,7 @@ TEST(AnalysisCli, PenumbraWritesTheTableCsvAndPlot) {
         "analyze penumbra --pixel-width 0.02",           // ... which only they have
         "analyze penumbra --spp -1 --pixel-width 0.02",
         "analyze penumbra --spp 16 --pixel-width nan",
+        "analyze penumbra --spp 16 --pixel-width 1e-7",  // too many pixels within the kernel's reach
     });
     // With --spp the stratified variance and its ratio to the independent samples'.
     ASSERT_EQ(test::runWedge("analyze penumbra --points 11 --spp 16 --pixel-width 0.02", &out), 0);

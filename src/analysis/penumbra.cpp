@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 
 #include "core/error.h"
@@ -114,6 +115,16 @@ double stratifiedVariance(const PenumbraKernel& kernel, const PenumbraSetup& set
 
 PenumbraResponse penumbraResponse(int pairs, const PenumbraSetup& set) {
     const PenumbraKernel kernel = penumbraKernel(pairs, set);
+    if (set.spp > 0) {
+        // The stratified quadrature's kernel evaluations (stratifiedVariance): bounded, so that a
+        // tiny pixel width is an error, not a computation of hours.
+        const double pixels = 2 * kernel.reach / set.pixelWidth + 2, qy = std::max(4, 512 / set.spp);
+        const double work = pixels * 16 * set.spp * qy * double(kernel.terms.size()) * set.points;
+        if (work > 2e9)
+            throw Error("--pixel-width", "the kernel reaches over " + std::to_string(int64_t(pixels)) +
+                                             " pixels of this width: the stratified variance would take too long "
+                                             "(wider pixels, or fewer --spp or --points)");
+    }
     const double L = set.lightHalfLength, s = set.slope;
     // Kernel k(a, y) on a grid of offsets a (midpoints, symmetric about 0) and light positions y.
     double sxMax = 0, cxMax = 0;
