@@ -209,6 +209,17 @@ TEST(ExperimentCommand, CachesTheReferenceAndShowsProgressUnlessQuiet) {
     ASSERT_EQ(test::runWedge(args16 + " --quiet", &out, &err), 0) << err;
     EXPECT_EQ(out, "");
     EXPECT_EQ(err, "");
+    // The methods' --sampler is not the reference's (its cache key names none): rendered afresh
+    // with the methods' independent samples, the reference is the same file.
+    const std::string dirIndependent = test::tempDir() + "/exp-independent";
+    ASSERT_EQ(test::runWedge("experiment cornell --methods mc --spp 2 --reference-spp 16 --quiet --sampler independent --out " +
+                                 dirIndependent + " --resolution 16x16",
+                             &out, &err),
+              0)
+        << err;
+    for (const auto& e : fs::directory_iterator(dir + "/cache"))
+        if (e.path().extension() == ".exr")
+            EXPECT_EQ(test::readFile(e.path().string()), test::readFile(dirIndependent + "/cache/" + e.path().filename().string()));
     // A different resolution is a different reference.
     ASSERT_EQ(test::runWedge(args + "12x12 --quiet", &out, &err), 0) << err;
     cached = 0;

@@ -238,6 +238,9 @@ void Experiment::loadOrRenderReference() {
     say("rendering the reference: mc, " + std::to_string(m_result.referenceSpp) + " spp in two independent halves");
     RenderOptions o = renderOptions("mc", nA, m_result.referenceSeed, m_options.quiet);
     o.layers = "off";  // plain Monte Carlo: the layered reconstruction's smoothing is a bias at any spp
+    // The default sampler whatever the methods' (--sampler): the cache key names no sampler, and
+    // the reference is the best estimate at its samples.
+    o.sampler = RenderOptions().sampler;
     RenderResult a = render(m_scene, o);
     o.spp = nB;
     o.seed = hashCombine(m_result.referenceSeed, 0x68616c66U);
