@@ -30,10 +30,12 @@ void validatePenumbra(const PenumbraSetup& s) {
     if (s.spp == 0 && s.pixelWidth != 0) throw Error("--pixel-width", "only with --spp (the stratified samples' pixels)");
 }
 
+double PenumbraKernel::Term::envelope(double a) const { return weight * sx * std::exp(-0.5 * sx * sx * a * a); }
+
 double PenumbraKernel::operator()(double a, double y) const {
     if (std::abs(a) > reach) return 0;
     double k = 0;
-    for (const Term& t : terms) k += t.weight * t.sx * std::exp(-0.5 * t.sx * t.sx * a * a) * std::cos(t.cx * a - t.cy * y);
+    for (const Term& t : terms) k += t.envelope(a) * std::cos(t.cx * a - t.cy * y);
     return k;
 }
 
@@ -62,14 +64,18 @@ PenumbraKernel penumbraKernel(int pairs, const PenumbraSetup& set) {
 
 namespace {
 
+/// stratifiedVariance's midpoint quadrature: positions per pixel, and light positions per
+/// stratum (enough for 512 over the light, at least 4).
+constexpr int kStratifiedPixelPoints = 16;
+int stratumPoints(int spp) { return std::max(4, 512 / spp); }
+
 /// rho Var(sum_i k_i (v_i - m)) with the samples stratified: the sum over the cells (a pixel of
 /// width D, one of the spp strata of the light) of the variance of k (v - m) within the cell,
 /// times rho = spp / D (so that it is the same quantity as E[k^2 (v - m)^2], the independent
-/// samples'). By midpoint quadrature in each cell: kQx positions in the pixel, enough light
-/// positions per stratum for 512 over the light.
+/// samples'). By midpoint quadrature in each cell.
 double stratifiedVariance(const PenumbraKernel& kernel, const PenumbraSetup& set, double x, double m) {
-    constexpr int kQx = 16;
-    const int n = set.spp, qy = std::max(4, 512 / n);
+    constexpr int kQx = kStratifiedPixelPoints;
+    const int n = set.spp, qy = stratumPoints(n);
     const double D = set.pixelWidth, L = set.lightHalfLength, s = set.slope, stratum = 2 * L / n;
     // cos(C_x a - C_y y) = cos(C_x a) cos(C_y y) + sin(C_x a) sin(C_y y): the y factors per light
     // position, the a factors (with the Gaussian) per position in the pixel.
@@ -93,7 +99,7 @@ double stratifiedVariance(const PenumbraKernel& kernel, const PenumbraSetup& set
             if (std::abs(a) > kernel.reach) continue;  // k = 0 there
             for (size_t t = 0; t < terms; ++t) {
                 const auto& term = kernel.terms[t];
-                const double g = term.weight * term.sx * std::exp(-0.5 * term.sx * term.sx * a * a);
+                const double g = term.envelope(a);
                 ca[t] = g * std::cos(term.cx * a);
                 sa[t] = g * std::sin(term.cx * a);
             }
@@ -118,8 +124,8 @@ PenumbraResponse penumbraResponse(int pairs, const PenumbraSetup& set) {
     if (set.spp > 0) {
         // The stratified quadrature's kernel evaluations (stratifiedVariance): bounded, so that a
         // tiny pixel width is an error, not a computation of hours.
-        const double pixels = 2 * kernel.reach / set.pixelWidth + 2, qy = std::max(4, 512 / set.spp);
-        const double work = pixels * 16 * set.spp * qy * double(kernel.terms.size()) * set.points;
+        const double pixels = 2 * kernel.reach / set.pixelWidth + 2;
+        const double work = pixels * kStratifiedPixelPoints * set.spp * stratumPoints(set.spp) * double(kernel.terms.size()) * set.points;
         if (work > 2e9)
             throw Error("--pixel-width", "the kernel reaches over " + std::to_string(int64_t(pixels)) +
                                              " pixels of this width: the stratified variance would take too long "

@@ -51,6 +51,8 @@ struct PenumbraSetup {
 struct PenumbraKernel {
     struct Term {
         double weight, sx, cx, cy;  // weight c_p mu_p, the Gaussian's Fourier std, the centre (C_x, C_y)
+        /// The weighted spatial Gaussian at offset a (its modulation cos(C_x a - C_y y) apart).
+        double envelope(double a) const;
     };
     std::vector<Term> terms;
     double reach = 0;  // |a| beyond which k = 0 (the window, or 8 std of the widest Gaussian)

@@ -89,7 +89,6 @@ public:
     /// Independent uniform numbers instead of the stratified Sobol points (PixelSampler;
     /// `--sampler independent`).
     void setIndependentSamples(bool independent) { m_independent = independent; }
-    bool independentSamples() const { return m_independent; }
     /// Over several ranks (render/distribution.h): this rank traces only its own rows, and the
     /// sampling stages copy what they computed to every rank. Null: one process, every row.
     void distribute(const Distribution* d, int rank, int ranks) {
