@@ -948,7 +948,18 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                     // it they give the true blur, a disc of radius |c| (c^2 / 4 per axis) and a
                     // segment of length |m| (m^2 / 12); a layer whose true blur is below the
                     // grid's own with the smallest sigma is sharp.
-                    l.sharp = l.sharpRun || isSharp(l.c, spread, motion, o);
+                    // A blurred layer's grid reaches |c| + |m| / 2 + 3 sigma beyond its tile,
+                    // wherever the rays read it, also past the trajectories a tile gathers
+                    // (LayerOptions::maxReach): there it holds only the samples gathered, but N
+                    // and D alike (the samples of the same source pixels), so its coverage stays
+                    // right for the rays of this tile, whose own pixels are among them. (Capped at
+                    // maxReach, a fast box's 220-px trail lost its ends: the rays read the
+                    // clamped edge of the grid; docs/layers.md, "Motion longer than the reach".)
+                    // Past LayerOptions::maxGridMargin (the grid's memory) a layer is not
+                    // reprojected: its pixels' own samples, unbiased.
+                    const float sigmaIfBlurred = std::clamp(o.sigmaScale * std::abs(l.c), o.sigmaMin, o.sigmaMax);
+                    const bool beyondGrid = std::abs(l.c) + 0.5f * motion + 3.f * sigmaIfBlurred + 1.f > float(o.maxGridMargin);
+                    l.sharp = l.sharpRun || beyondGrid || isSharp(l.c, spread, motion, o);
                     l.rayC = l.c, l.rayMx = l.mx, l.rayMy = l.my;
                     int lm = 0;
                     if (!l.sharp) {
@@ -980,15 +991,16 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                             l.motionScale = k.a;
                             l.rayT2 = k.a > 0 ? k.b / k.a : 0.f;
                         }
-                        lm = int(std::ceil(std::abs(l.c) + 0.5f * motion + 3.f * l.sigma)) + 1;
-                        lm = std::min(lm, o.maxReach + int(pad));
+                        lm = int(std::ceil(std::abs(l.c) + 0.5f * motion + 3.f * l.sigma)) + 1;  // (at most maxGridMargin: above)
                         anyBlurred = true;
                     }
                     l.gx0 = X0 - lm;
                     l.gy0 = Y0 - lm;
                     l.gw = X1 - X0 + 2 * lm;
                     l.gh = Y1 - Y0 + 2 * lm;
-                    l.timeBins = l.moving ? kTimeBins : 1;
+                    // (A sharp layer's pixels take one ray where the whole tile is sharp: its
+                    // radiance is its pixel's samples over the whole shutter, not one bin's.)
+                    l.timeBins = l.moving && !l.sharp ? kTimeBins : 1;
                     l.acc.assign(size_t(l.gw) * l.gh * l.accStride(), 0.f);
                     l.accD.assign(size_t(l.gw) * l.gh, 0.f);
                 }

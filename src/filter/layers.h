@@ -75,7 +75,11 @@ namespace wedge::filter {
 
 struct LayerOptions {
     int tile = 64;             // pixels
-    int maxReach = 48;         // pixels: a sample's trajectory is followed at most this far (the cost bound)
+    int maxReach = 48;         // pixels: a tile gathers the samples whose trajectories reach it from at most this far (the cost bound)
+    // pixels: a blurred layer's grid reaches at most this far beyond its tile (its memory: (64 +
+    // 2 x 128)^2 cells); a layer whose blur, |c| + |m| / 2 + 3 sigma, would reach farther keeps
+    // its pixels' own samples (layers.cpp).
+    int maxGridMargin = 128;
     float sigmaScale = 0.15f;  // the sharp image's Gaussian: sigmaScale |c_l|, clamped to [sigmaMin, sigmaMax]
     float sigmaMin = 0.5f, sigmaMax = 2.f;
     // ... and the coverage's (N, D) and the slopes': sigmaScale |c_l| clamped to [sigmaCoverageMin,
