@@ -37,6 +37,10 @@ int runRanks(int n, const std::string& args, std::string* err = nullptr, const s
         launcher = std::string(kMpiexec) + " --oversubscribe --bind-to none -n " + std::to_string(n) + " ";
         if (geteuid() == 0) launcher += "--allow-run-as-root ";
         launcher += "--mca btl self,vader ";  // one machine: shared memory only
+        // Each job its own session directory: two jobs of ctest -j starting together both
+        // created /tmp/ompi.HOST.UID and one failed with "mkdir ... File exists" (Open MPI 4.1,
+        // seen once in CI on Mpi.AFailingRankEndsTheJobWithItsMessage).
+        launcher += "--mca orte_tmpdir_base " + dir + " ";
         for (const char* var : {"WEDGE_MPI_FAULT", "WEDGE_MPI_TIMEOUT"})
             if (env.find(var) != std::string::npos) launcher += std::string("-x ") + var + " ";
     }

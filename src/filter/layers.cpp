@@ -44,8 +44,13 @@ constexpr float kMoving = 0.5f;
 /// length) of its own, else starts one; past the last group it joins the nearest. (Tolerances
 /// 2 px / 25%, 3 / 35%, 4 / 50% and 8 / 100% measured within 3% of each other in relMSE on
 /// raster-pan-like and raster-motion-defocus-like scenes; 4 / 50% the best or level, with the
-/// fewest layers after 8 / 100%: docs/layers.md, "Surfaces moving apart".)
-constexpr int kMotionGroups = 3;
+/// fewest layers after 8 / 100%: docs/layers.md, "Surfaces moving apart".) Eight groups, not
+/// three: a sphere moving towards the camera spreads its samples' motion radially over several
+/// groups, and with three a box crossing the same tiles joined one of them, the sphere's (AAF
+/// `--layers on` relMSE on docs/fast-motion.json 0.000621 -> 0.000181; of the six other scenes
+/// with motion only raster-pan changed, 0.6-2.2% lower: docs/layers.md, "An object moving in
+/// depth").
+constexpr int kMotionGroups = 8;
 constexpr float kMotionTolerance = 4.f, kMotionToleranceRel = 0.5f;
 constexpr int kClasses = 1 + kMotionGroups;
 /// A moving layer keeps its radiance in this many bins of shutter time: a moving surface's
@@ -339,17 +344,63 @@ int mergeSharpRuns(Split::Histogram& h, int nLayers, const LayerOptions& o, cons
     return merged;
 }
 
+/// How a tile's motion group's defocus slope changes over the shutter, pixels per shutter: an
+/// object moving towards or away from the camera changes its slope as it moves (a sphere moving
+/// 2.2 towards a camera focused at 4, from 5 to 2.8 away: -1 -> +2.3 px). Split by the slopes its
+/// samples were taken at, such an object's samples fell into layers by shutter time, each with a
+/// coverage averaged over the shutter and interleaved in the tile's one order with the still
+/// layers at those depths, and it came out partly transparent (docs/layers.md, "An object moving
+/// in depth"); its samples are split by their slope at mid-shutter, c - rate (t - 1/2), instead.
+/// The rate is the regression of the samples' slopes on their shutter times within cells of
+/// kRateCell pixels of the sharp image (where a sample lies at mid-shutter): the samples of one
+/// surface point, so that surfaces of different depths passing through the tile over the
+/// shutter (a camera pan over a set whose depth varies) do not count as a change. It counts
+/// where it is at least the layers' slope tolerance (LayerOptions::splitMin) and three of its
+/// standard errors; 0 otherwise.
+constexpr int kRateCell = 8;
+struct SlopeMoments {
+    double n = 0, t = 0, c = 0, tt = 0, ct = 0, cc = 0;
+    void add(float slope, float time) {
+        n += 1;
+        t += time;
+        c += slope;
+        tt += double(time) * time;
+        ct += double(slope) * time;
+        cc += double(slope) * slope;
+    }
+};
+/// The pooled within-cell regression of `count` cells' moments (above).
+float slopeRate(const SlopeMoments* cells, size_t count, const LayerOptions& o) {
+    double sxx = 0, sxy = 0, syy = 0, n = 0, groups = 0;
+    for (size_t k = 0; k < count; ++k) {
+        const SlopeMoments& m = cells[k];
+        if (m.n < 2) continue;
+        sxx += m.tt - m.t * m.t / m.n;
+        sxy += m.ct - m.t * m.c / m.n;
+        syy += m.cc - m.c * m.c / m.n;
+        n += m.n;
+        groups += 1;
+    }
+    if (n - groups < 3 || !(sxx > 1e-6)) return 0.f;
+    const double beta = sxy / sxx;
+    const double se2 = std::max(0.0, syy - beta * sxy) / (n - groups - 1) / sxx;
+    return std::abs(beta) >= o.splitMin && beta * beta >= 9.0 * se2 ? float(beta) : 0.f;
+}
+
 /// Splits the tile's samples into layers, front to back (see layers.h, step 1).
-/// `range[cls]`: the slopes of the still samples and of each motion group's. One pass over the samples,
+/// `range[cls]`: the slopes of the still samples and of each motion group's; `rate[cls]`: how a
+/// group's slope changes over the shutter (SlopeRate), whose samples are split by their slope at
+/// mid-shutter (`split[cls]`: their range); a layer's slopes are its samples' own. One pass over the samples,
 /// both classes at once, into the histograms and their bins' sums (the tile's samples are
 /// megabytes: each pass is a trip through memory; three passes, with one to set each sample's
 /// layer and one to renumber it front to back, were a tenth of an MC render of
 /// docs/motion.json); the splat takes each sample's layer from its bin (Split::layerOf).
 template <class Samples>
-void splitLayers(Samples& g, const SlopeRange (&range)[kClasses], const LayerOptions& o, Split& split) {
+void splitLayers(Samples& g, const SlopeRange (&range)[kClasses], const float (&rate)[kClasses],
+                 const SlopeRange (&splitRange)[kClasses], const LayerOptions& o, Split& split) {
     auto& hist = split.hist;
     for (int cls = 0; cls < kClasses; ++cls) {
-        const SlopeRange& r = range[cls];
+        const SlopeRange& r = splitRange[cls];
         Split::Histogram& h = hist[cls];
         h.bins = 0;
         if (r.empty()) continue;
@@ -387,7 +438,7 @@ void splitLayers(Samples& g, const SlopeRange (&range)[kClasses], const LayerOpt
         r = Run{};
     };
     for (Gathered& s : g) {
-        const int b = hist[s.cls].bin(s.c);
+        const int b = hist[s.cls].bin(s.c - rate[s.cls] * (s.t - 0.5f));
         s.bin = uint16_t(b);
         Run& r = run[s.cls];
         if (b != r.bin) {
@@ -804,6 +855,7 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
         // Left unwritten when it grows; huge pages for its megabytes (LargeAllocator).
         std::vector<Gathered, UnwrittenAllocator<Gathered>> g;
         Split split;
+        std::vector<SlopeMoments> moments;  // per motion group and cell (slopeRate)
     };
     tbb::enumerable_thread_specific<Scratch> scratch;
     parallelTiles(tilesX, tilesY, 1, [&](int tx0, int tx1, int ty0, int ty1) {
@@ -935,7 +987,40 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                     const Image3f* light = s.surface >= 0 && !own ? in.surfaceLight[s.surface] : nullptr;
                     return light ? unpackRgb9e5(s.albedo) * (*light)[s.pixel] : unpackRgb9e5(s.radiance);
                 };
-                splitLayers(g, range, o, split);
+                // A motion group's slope over the shutter (SlopeRate), and the range of its
+                // samples' slopes at mid-shutter.
+                float rate[kClasses] = {};
+                SlopeRange splitRange[kClasses];
+                std::copy(range, range + kClasses, splitRange);
+                if (groups > 0) {
+                    // Moments per motion group and kRateCell cell of the sharp image, over the
+                    // apron and a margin of 64 px (beyond it, the border cells).
+                    const int ox = rx0 - 64, oy = ry0 - 64;
+                    const int nx = (rx1 - rx0 + 128) / kRateCell + 1, ny = (ry1 - ry0 + 128) / kRateCell + 1;
+                    const size_t cells = size_t(nx) * ny;
+                    auto& moments = local.moments;
+                    moments.assign(size_t(groups) * cells, SlopeMoments{});
+                    for (const Gathered& a : g) {
+                        if (a.cls == 0) continue;
+                        const Vec2f p = shearOf(a, a.c, a.mx, a.my);
+                        const int ix = std::clamp(int(std::floor((p.x - float(ox)) / float(kRateCell))), 0, nx - 1);
+                        const int iy = std::clamp(int(std::floor((p.y - float(oy)) / float(kRateCell))), 0, ny - 1);
+                        moments[size_t(a.cls - 1) * cells + size_t(iy) * nx + ix].add(a.c, a.t);
+                    }
+                    bool any = false;
+                    for (int k = 1; k <= groups; ++k) any |= (rate[k] = slopeRate(&moments[size_t(k - 1) * cells], cells, o)) != 0.f;
+                    if (any) {
+                        for (int k = 1; k < kClasses; ++k)
+                            if (rate[k] != 0.f) splitRange[k] = SlopeRange{};
+                        for (const Gathered& a : g) {
+                            if (rate[a.cls] == 0.f) continue;
+                            const float c = a.c - rate[a.cls] * (a.t - 0.5f);
+                            splitRange[a.cls].lo = std::min(splitRange[a.cls].lo, c);
+                            splitRange[a.cls].hi = std::max(splitRange[a.cls].hi, c);
+                        }
+                    }
+                }
+                splitLayers(g, range, rate, splitRange, o, split);
                 std::vector<Layer>& layers = split.layers;
                 layerTotal += layers.size();
                 bool anyBlurred = false;

@@ -13,10 +13,12 @@
 // lens's u, film y downward against its v: y_y = y - c v - m_y (t - 1/2)). Samples of one
 // surface collapse there onto a sharp image, so samples of many pixels can be reused.
 //
-// Per screen tile (64 pixels, with an apron as wide as the trajectories that reach it):
-// 1. The samples are split into depth layers: still samples and up to three groups of moving
+// Per screen tile (64 pixels, with an apron as wide as the trajectories that reach it, at most
+// LayerOptions::maxReach):
+// 1. The samples are split into depth layers: still samples and up to eight groups of moving
 //    ones of like motion apart (layers.cpp, kMotionGroups), each sorted by defocus slope (which
-//    falls with depth); a new layer starts where the slopes spread more than
+//    falls with depth; a moving group whose slope changes over the shutter, an object moving in
+//    depth, by its slope at mid-shutter: layers.cpp, slopeRate); a new layer starts where the slopes spread more than
 //    max(0.5, 0.15 |c|) pixels or jump by half a pixel; consecutive still layers that are each
 //    sharp (below) are one, which composites exactly as they would (at most 16 layers, the
 //    thresholds widened until they fit). Layers are composited in the order of their mean
