@@ -374,12 +374,10 @@ TEST(Layers, ANearFocusEdgeSharesItsSamplesWhereTheyCarryTheirOwnRadiance) {
 
 namespace {
 
-/// A lit strip 0.2 wide at depth 4 moving `velocity` to the right over nothing (pinhole), with
-/// `spp` samples, with and without layers, against its shutter average: a pixel is the strip's
-/// radiance times the share of the shutter the strip covers it.
-/// A strip of `width` world units at x0 .. x0 + width, 4 in front of a pinhole camera (91.4 px
-/// focal length), moving by `velocity` along x over the shutter, on a `pixels` x 16 image, with
-/// layers and without, against its shutter average.
+/// A lit strip over nothing, `width` wide at x0 .. x0 + width and depth 4 before a pinhole (91.4
+/// px focal length), moving `velocity` to the right over the shutter, on a `pixels` x 16 image
+/// with `spp` samples, with and without layers, against its shutter average: a pixel is the
+/// strip's radiance times the share of the shutter the strip covers it.
 ColumnErrors movingStripErrors(float velocity, int spp, int pixels = 64, float x0 = -0.4f, float width = 0.2f) {
     auto strip = [&](float v) {
         std::string json = R"({

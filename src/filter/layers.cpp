@@ -48,8 +48,7 @@ constexpr float kMoving = 0.5f;
 /// three: a sphere moving towards the camera spreads its samples' motion radially over several
 /// groups, and with three a box crossing the same tiles joined one of them, the sphere's (AAF
 /// `--layers on` relMSE on docs/fast-motion.json 0.000621 -> 0.000181; of the six other scenes
-/// with motion only raster-pan changed, 0.6-2.2% lower: docs/layers.md, "An object moving in
-/// depth").
+/// with motion only raster-pan changed, 0.6-2.2% lower: docs/layers.md, "Motion longer than a tile's reach, and an object moving in depth").
 constexpr int kMotionGroups = 8;
 constexpr float kMotionTolerance = 4.f, kMotionToleranceRel = 0.5f;
 constexpr int kClasses = 1 + kMotionGroups;
@@ -349,8 +348,8 @@ int mergeSharpRuns(Split::Histogram& h, int nLayers, const LayerOptions& o, cons
 /// 2.2 towards a camera focused at 4, from 5 to 2.8 away: -1 -> +2.3 px). Split by the slopes its
 /// samples were taken at, such an object's samples fell into layers by shutter time, each with a
 /// coverage averaged over the shutter and interleaved in the tile's one order with the still
-/// layers at those depths, and it came out partly transparent (docs/layers.md, "An object moving
-/// in depth"); its samples are split by their slope at mid-shutter, c - rate (t - 1/2), instead.
+/// layers at those depths, and it came out partly transparent (docs/layers.md, "Motion longer than a tile's reach, and an object moving in depth");
+/// its samples are split by their slope at mid-shutter, c - rate (t - 1/2), instead.
 /// The rate is the regression of the samples' slopes on their shutter times within cells of
 /// kRateCell pixels of the sharp image (where a sample lies at mid-shutter): the samples of one
 /// surface point, so that surfaces of different depths passing through the tile over the
@@ -388,9 +387,10 @@ float slopeRate(const SlopeMoments* cells, size_t count, const LayerOptions& o) 
 }
 
 /// Splits the tile's samples into layers, front to back (see layers.h, step 1).
-/// `range[cls]`: the slopes of the still samples and of each motion group's; `rate[cls]`: how a
-/// group's slope changes over the shutter (SlopeRate), whose samples are split by their slope at
-/// mid-shutter (`split[cls]`: their range); a layer's slopes are its samples' own. One pass over the samples,
+/// `range[cls]`: the slopes of the still samples and of each motion group's (what mergeSharpRuns
+/// cuts at); `rate[cls]`: how a group's slope changes over the shutter (slopeRate), whose samples
+/// are binned by their slope at mid-shutter (`splitRange[cls]`: the range of the slopes binned);
+/// a layer's slopes are its samples' own. One pass over the samples,
 /// both classes at once, into the histograms and their bins' sums (the tile's samples are
 /// megabytes: each pass is a trip through memory; three passes, with one to set each sample's
 /// layer and one to renumber it front to back, were a tenth of an MC render of
@@ -987,7 +987,7 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                     const Image3f* light = s.surface >= 0 && !own ? in.surfaceLight[s.surface] : nullptr;
                     return light ? unpackRgb9e5(s.albedo) * (*light)[s.pixel] : unpackRgb9e5(s.radiance);
                 };
-                // A motion group's slope over the shutter (SlopeRate), and the range of its
+                // A motion group's slope over the shutter (slopeRate), and the range of its
                 // samples' slopes at mid-shutter.
                 float rate[kClasses] = {};
                 SlopeRange splitRange[kClasses];
@@ -1039,19 +1039,19 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                     // and D alike (the samples of the same source pixels), so its coverage stays
                     // right for the rays of this tile, whose own pixels are among them. (Capped at
                     // maxReach, a fast box's 220-px trail lost its ends: the rays read the
-                    // clamped edge of the grid; docs/layers.md, "Motion longer than the reach".)
+                    // clamped edge of the grid; docs/layers.md, "Motion longer than a tile's reach, and an object moving in depth".)
                     // Past LayerOptions::maxGridMargin (the grid's memory) a layer is not
                     // reprojected: its pixels' own samples, unbiased.
-                    const float sigmaIfBlurred = std::clamp(o.sigmaScale * std::abs(l.c), o.sigmaMin, o.sigmaMax);
-                    const bool beyondGrid = std::abs(l.c) + 0.5f * motion + 3.f * sigmaIfBlurred + 1.f > float(o.maxGridMargin);
-                    l.sharp = l.sharpRun || beyondGrid || isSharp(l.c, spread, motion, o);
+                    const float sigma = std::clamp(o.sigmaScale * std::abs(l.c), o.sigmaMin, o.sigmaMax);
+                    const float gridReach = std::abs(l.c) + 0.5f * motion + 3.f * sigma;  // beyond the tile, the rays' cells
+                    l.sharp = l.sharpRun || gridReach + 1.f > float(o.maxGridMargin) || isSharp(l.c, spread, motion, o);
                     l.rayC = l.c, l.rayMx = l.mx, l.rayMy = l.my;
                     int lm = 0;
                     if (!l.sharp) {
                         // (Not widened by the slopes' spread: the rays follow the slope they find. Half the
                         // spread, as it was, over-blurred the layers a tile's budget had widened: AAF
                         // relMSE on docs/conference-wide.json with a budget of 8 layers 0.000927 -> 0.000667.)
-                        l.sigma = std::clamp(o.sigmaScale * std::abs(l.c), o.sigmaMin, o.sigmaMax);
+                        l.sigma = sigma;
                         // The coverage's Gaussian may be narrower than the radiance's: a Gaussian
                         // of 0.5 px sampled at 1-px cells is aliased, and the edge it gives a
                         // layer just past the sharp threshold depends on where the edge falls
@@ -1076,7 +1076,7 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                             l.motionScale = k.a;
                             l.rayT2 = k.a > 0 ? k.b / k.a : 0.f;
                         }
-                        lm = int(std::ceil(std::abs(l.c) + 0.5f * motion + 3.f * l.sigma)) + 1;  // (at most maxGridMargin: above)
+                        lm = int(std::ceil(gridReach)) + 1;  // (at most maxGridMargin: above)
                         anyBlurred = true;
                     }
                     l.gx0 = X0 - lm;
