@@ -747,3 +747,24 @@ TEST(SceneFile, DiffuseMapsWedgeCannotReadAreNamed) {
               std::string::npos)
         << errorOf([&] { loadObjFile(dir + "/q.obj"); });
 }
+
+// Every scene file the docs measure on (docs/*.json, docs/lamps/*.json) loads without a warning,
+// has something to see and a light: a docs table whose scene no longer parses is a table
+// nobody can reproduce.
+TEST(Scene, EveryDocsSceneLoads) {
+    namespace fs = std::filesystem;
+    int n = 0;
+    for (const char* dir : {"docs", "docs/lamps"}) {
+        for (const auto& e : fs::directory_iterator(fs::path(test::sourceDir()) / dir)) {
+            if (e.path().extension() != ".json") continue;
+            SCOPED_TRACE(e.path().string());
+            scene::SceneDesc d;
+            ASSERT_NO_THROW(d = scene::loadScene(e.path().string()));
+            EXPECT_TRUE(d.warnings.empty());
+            EXPECT_GT(d.triangleCount() + d.spheres.size(), 0u);
+            EXPECT_FALSE(d.lights.empty());
+            ++n;
+        }
+    }
+    EXPECT_GE(n, 18);
+}
