@@ -813,10 +813,21 @@ bool traceBlurred(const Layer& l, int index, Rays& ray, int j0, int j1) {
 
 }  // namespace
 
-Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStats* stats) {
+bool samplesSharpAndStill(const LightFieldSamples& lf, size_t p, const ViewGeometry& view, const LayerOptions& o) {
+    bool sharp = true;
+    lf.forEach(p, [&](const LightFieldSample& s) {
+        const Vec2f m = s.motion();
+        const float c = view.defocusSlope(s.hit() ? s.depth : kInf);
+        sharp = sharp && m.x * m.x + m.y * m.y <= kMoving * kMoving && std::isfinite(c) && isSharp(c, 0.f, 0.f, o);
+    });
+    return sharp;
+}
+
+Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStats* stats, Image<uint8_t>* own) {
     const LightFieldSamples& lf = in.samples;
     const int W = lf.width(), H = lf.height();
     Image3f out(W, H);
+    if (own) *own = Image<uint8_t>(W, H);
     const ViewGeometry& view = in.view;
 
     // How far each pixel's samples' trajectories reach (2 |c| + |m| from where they were taken).
@@ -1258,6 +1269,7 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                             }
                         }
                         int pixelRays = sameForEveryRay ? 1 : rays;
+                        if (own) (*own)(x, y) = sameForEveryRay ? 1 : 0;
                         // The rays are traced a layer at a time, each layer over all the rays it
                         // has not yet stopped (transmittance below 1e-4): per ray the same
                         // front-to-back steps as ray after ray, with the layer's branches and

@@ -128,7 +128,16 @@ struct LayerStats {
     double straddlingPixels = 0;  // fraction of pixels whose first rays straddled layers (and took mixedRays)
 };
 
+/// Whether every sample pixel `p` holds is sharp and still: its defocus blur, a disc of radius
+/// |c|, and its screen motion below the grid's own blur with the smallest Gaussian (the sharp
+/// threshold of a layer whose samples carry filtered light). Where such a pixel's layers in
+/// front are sharp too, the reconstruction is its own samples (reconstructLayers' `own`).
+bool samplesSharpAndStill(const LightFieldSamples& samples, size_t p, const ViewGeometry& view, const LayerOptions& options = {});
+
 /// The reflected radiance (no emission) of every pixel, reconstructed from the light field.
-Image3f reconstructLayers(const LayerInput& input, const LayerOptions& options = {}, LayerStats* stats = nullptr);
+/// `own`, where given, is set to 1 in the pixels whose rays all end in sharp still layers (every
+/// ray finds the same values there: the pixel's own samples, composited), 0 elsewhere.
+Image3f reconstructLayers(const LayerInput& input, const LayerOptions& options = {}, LayerStats* stats = nullptr,
+                          Image<uint8_t>* own = nullptr);
 
 }  // namespace wedge::filter

@@ -21,7 +21,9 @@ void renderAtrous(const MethodContext& ctx, RenderResult& result) {
         const FrameBuffers& fb = result.buffers;
         const Image3f light = filter::atrousLight(fb, params);
         result.seconds.add("filter", t.seconds());
-        result.color = reconstructFromLayers(ctx, {&light, nullptr, nullptr}, result);
+        Image3f perPixel(fb.width, fb.height);
+        for (size_t i = 0; i < perPixel.size(); ++i) perPixel[i] = fb.compose(i, light[i], Vec3f(0.f));
+        result.color = reconstructFromLayers(ctx, {&light, nullptr, nullptr}, result, &perPixel);
     } else {
         result.color = filter::atrousFilter(result.buffers, params);
         result.seconds.add("filter", t.seconds());

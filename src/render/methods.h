@@ -61,16 +61,17 @@ constexpr uint32_t kMixedSpp = 64;
 
 
 /// Texture samples, in every method that multiplies filtered light by albedo (aaf, maaf, atrous)
-/// when it composes per pixel (no light field): where a pixel's path samples saw the albedo of a
-/// surface vary by more than kTextureVariance (PixelStats::albedoVariance), options.textureSpp
-/// primary hits more (PathSampler::primaryHits: a camera ray each, no light, no bounce), whose
-/// albedo joins that of the surface they land on and whose hits refine the surfaces' shares of
-/// the pixel (PixelStats::addPrimary). No filter reaches a
-/// texture's noise: a pixel's colour is its surface's filtered light times the mean albedo its
-/// camera rays saw, and 16-32 of them leave a checker's pixels noisy (docs/textures.md). Takes
-/// the pixels' sample indices on from their path samples' (the same seed, the same image on any
-/// number of threads or ranks). Adds the rays to result.rays and the pixels' count to
-/// result.extra ("texture_pixels").
+/// where it composes per pixel (with a light field: only in the pixels whose samples are sharp
+/// and still, filter::samplesSharpAndStill, which keep their own composition there): where a
+/// pixel's path samples saw the albedo of a surface vary by more than kTextureVariance
+/// (PixelStats::albedoVariance), options.textureSpp primary hits more (PathSampler::primaryHits:
+/// a camera ray each, no light, no bounce), whose albedo joins that of the surface they land on
+/// and whose hits refine the surfaces' shares of the pixel (PixelStats::addPrimary). No filter
+/// reaches a texture's noise: a pixel's colour is its surface's filtered light times the mean
+/// albedo its camera rays saw, and 16-32 of them leave a checker's pixels noisy
+/// (docs/textures.md). Takes the pixels' sample indices on from their path samples' (the same
+/// seed, the same image on any number of threads or ranks). Adds the rays to result.rays and the
+/// pixels' count to result.extra ("texture_pixels").
 void textureSamples(const MethodContext& ctx, PixelStatsImage& stats, RenderResult& result);
 /// The relative variance of a surface's albedo luminance above which a pixel takes texture samples.
 constexpr float kTextureVariance = 1e-4f;
@@ -91,9 +92,12 @@ double averageSpp(const FrameBuffers& fb);
 void finishLightField(const MethodContext& ctx, const PixelStatsImage& stats);
 /// The image of a method whose samples carry `surfaceLight` (null entries: their own radiance;
 /// filter/layers.h): each pixel's emission plus the layered reconstruction of the reflected light
-/// from ctx.lightField. Times the "layers" stage and adds its figures to result.extra.
+/// from ctx.lightField; with `perPixel` (the method's own composition of each pixel, emission
+/// included), that composition where the reconstruction is the pixel's own samples on sharp
+/// still layers (filter::reconstructLayers' `own`). Times the "layers" stage and adds its figures
+/// to result.extra.
 Image3f reconstructFromLayers(const MethodContext& ctx, const std::array<const Image3f*, 1 + FrameBuffers::kOtherSurfaces>& surfaceLight,
-                              RenderResult& result);
+                              RenderResult& result, const Image3f* perPixel = nullptr);
 
 /// The primary surface's visibility as rgb, the input of the direct-light filters.
 Image3f visibilityImage(const FrameBuffers& fb);

@@ -75,7 +75,7 @@ uint64_t denseEmission(const MethodContext& ctx, const Image<uint32_t>& topUp, F
 
 void textureSamples(const MethodContext& ctx, PixelStatsImage& stats, RenderResult& result) {
     const uint32_t count = uint32_t(std::max(ctx.options.textureSpp, 0));
-    if (count == 0 || ctx.lightField) {
+    if (count == 0) {
         result.extra.emplace_back("texture_pixels", 0.0);
         return;
     }
@@ -87,6 +87,10 @@ void textureSamples(const MethodContext& ctx, PixelStatsImage& stats, RenderResu
         for (int x = 0; x < stats.width(); ++x) {
             PixelStats& ps = stats(x, y);
             if (ps.albedoVariance() <= kTextureVariance) continue;
+            // With the layered reconstruction a pixel keeps its own composition only where its
+            // samples are sharp and still (reconstructFromLayers); elsewhere its colour is a mean
+            // over many pixels' samples, which averages the texture's noise already.
+            if (ctx.lightField && !filter::samplesSharpAndStill(*ctx.lightField, size_t(y) * stats.width() + x, ctx.view)) continue;
             localRays += ctx.sampler.primaryHits(x, y, ps.n, count, hits.data());
             for (const TracedSample& h : hits) ps.addPrimary(h);
             ++localPixels;
@@ -124,7 +128,7 @@ void finishLightField(const MethodContext& ctx, const PixelStatsImage& stats) {
 
 Image3f reconstructFromLayers(const MethodContext& ctx,
                               const std::array<const Image3f*, 1 + FrameBuffers::kOtherSurfaces>& surfaceLight,
-                              RenderResult& result) {
+                              RenderResult& result, const Image3f* perPixel) {
     Timer t;
     const FrameBuffers& fb = result.buffers;
     filter::LayerOptions lo;
@@ -148,9 +152,18 @@ Image3f reconstructFromLayers(const MethodContext& ctx,
         lo.movingRays = lo.mixedRays;
     }
     filter::LayerStats stats;
-    Image3f color = filter::reconstructLayers(filter::LayerInput{*ctx.lightField, ctx.view, surfaceLight}, lo, &stats);
+    // Where every ray of a pixel ends in sharp still layers the reconstruction is the pixel's own
+    // samples, composited; the method's own composition of the pixel (`perPixel`) is the same
+    // estimate with its texture samples' mean albedo (textureSamples) and is taken there.
+    // (docs/layers.md, "A pixel's own composition where its layers are sharp".)
+    Image<uint8_t> own;
+    Image3f color = filter::reconstructLayers(filter::LayerInput{*ctx.lightField, ctx.view, surfaceLight}, lo, &stats,
+                                              perPixel ? &own : nullptr);
+    size_t ownPixels = 0;
+    for (size_t p = 0; perPixel && p < own.size(); ++p) ownPixels += own[p];
     parallelRows(fb.height, [&](int y) {
-        for (size_t p = size_t(y) * fb.width; p < size_t(y + 1) * fb.width; ++p) color[p] += fb.emission[p];
+        for (size_t p = size_t(y) * fb.width; p < size_t(y + 1) * fb.width; ++p)
+            color[p] = perPixel && own[p] ? (*perPixel)[p] : color[p] + fb.emission[p];
     });
     result.seconds.add("layers", t.seconds());
     result.extra.emplace_back("layers_sample_bytes", double(ctx.lightField->bytes()));
@@ -158,6 +171,8 @@ Image3f reconstructFromLayers(const MethodContext& ctx,
     result.extra.emplace_back("layers_per_tile", stats.layersPerTile);
     result.extra.emplace_back("layers_blurred_tiles", stats.blurredTiles);
     result.extra.emplace_back("layers_straddling_pixels", stats.straddlingPixels);
+    if (perPixel)
+        result.extra.emplace_back("layers_own_pixels", double(ownPixels) / double(std::max<size_t>(1, size_t(fb.width) * fb.height)));
     return color;
 }
 
@@ -168,7 +183,8 @@ Image3f composeFilteredLight(const MethodContext& ctx, const Image3f& filteredVi
     for (size_t i = 0; i < direct.size(); ++i) direct[i] = fb.directUnoccluded[i] * filteredVisibility[i].x;
     if (ctx.lightField) {
         const std::array<Image3f, 1 + FrameBuffers::kOtherSurfaces> light = fb.surfaceLight(direct, filteredIndirect);
-        return reconstructFromLayers(ctx, {&light[0], &light[1], &light[2]}, result);
+        const Image3f perPixel = fb.composeFiltered(direct, filteredIndirect);  // as without layers, but the defocus filter
+        return reconstructFromLayers(ctx, {&light[0], &light[1], &light[2]}, result, &perPixel);
     }
     Image3f color = fb.composeFiltered(direct, filteredIndirect);
     return ctx.view.apertureRadius > 0 ? filter::defocusFilter(color, fb) : color;
