@@ -488,6 +488,36 @@ TEST(Render, ALayeredPixelOnSharpLayersKeepsItsOwnCompositionWithTextureSamples)
     }
 }
 
+TEST(Render, AnEmittersEdgeTakesItsDenseEmissionAtAnySampleCountBelowItsRays) {
+    // A lamp seen from below, MC without layers: a pixel on its edge takes its emitted light from
+    // kEmitterEdgeRays camera rays (denseEmission), the same value at 16 samples a pixel (topped
+    // up to 256) and at 256, where before it kept its 256 samples' own (cornell at 256x256, 256
+    // spp: relMSE 0.000190 before, 0.000131 with them, against a 1024-spp render).
+    const scene::Scene s(parse(R"({
+      "camera": {"position": [0, 0, 0], "look_at": [0, 1, 0], "up": [0, 0, 1], "fov_y": 40, "resolution": [24, 24]},
+      "materials": {"grey": {"albedo": [0.5, 0.5, 0.5]}},
+      "lights": [{"type": "parallelogram", "corner": [-0.3, 1, -0.2], "edge1": [0.6, 0, 0], "edge2": [0, 0, 0.4], "radiance": [5, 5, 5]}],
+      "objects": [{"type": "quad", "corner": [-3, 1.01, -3], "edge1": [0, 0, 6], "edge2": [6, 0, 0], "material": "grey"}],
+      "render": {"spp": 16, "seed": 3, "indirect": false}
+    })"));
+    render::RenderOptions o;
+    o.quiet = true;
+    o.method = "mc";
+    o.layers = "off";
+    o.spp = 16;
+    const render::RenderResult few = render::render(s, o);
+    o.spp = int(render::kEmitterEdgeSpp);
+    const render::RenderResult many = render::render(s, o);
+    int edges = 0;
+    for (size_t p = 0; p < few.buffers.emission.size(); ++p) {
+        const Vec3f e = few.buffers.emission[p];
+        if (!(e.x > 0.f && e.x < 5.f)) continue;  // the lamp's edge: partly lit
+        ++edges;
+        EXPECT_EQ(e, many.buffers.emission[p]) << "pixel " << p;
+    }
+    EXPECT_GE(edges, 20);  // the lamp's outline, about 2 x (14 + 10) pixels
+}
+
 TEST(Render, ALampOfTrianglesIsOneLightForTheFilters) {
     // kPlaneScene's light as the fan of four triangles about its centre: the filters see one
     // light (ViewGeometry::lights), with the whole light's centroid, size and parts, and every

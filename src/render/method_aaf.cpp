@@ -42,6 +42,7 @@ void renderAaf(const MethodContext& ctx, RenderResult& result) {
     filter::AafParams params = filter::aafParams(fb, wedges, view, ao);
     Image<uint32_t> extra(W, H);
     const Image<uint32_t> emitterExtra = emitterTopUps(stats, kEmitterEdgeSpp);
+    const Image<uint32_t> emitterEdges = emitterTopUps(stats, kEmitterEdgeRays);  // (denseEmission)
     uint64_t extraTotal = 0;
     for (size_t i = 0; i < extra.size(); ++i) {
         float need = std::max({params.sppDirect[i], params.sppIndirect[i], params.sppLens[i]});
@@ -63,7 +64,7 @@ void renderAaf(const MethodContext& ctx, RenderResult& result) {
     textureSamples(ctx, stats, result);
     storeStats(stats, ctx, fb);
     finishLightField(ctx, stats);
-    result.rays += denseEmission(ctx, emitterExtra, fb);
+    result.rays += denseEmission(ctx, emitterEdges, fb);
     stats = PixelStatsImage();  // freed before the filter's buffers: a lower peak, fewer fresh pages
     result.seconds.add("sampling_adaptive", t.seconds());
     result.seconds.add("sampling", result.seconds.get("sampling_initial") + result.seconds.get("sampling_adaptive"));

@@ -232,6 +232,7 @@ void renderMaaf(const MethodContext& ctx, RenderResult& result) {
     const filter::AafParams rates = filter::aafParams(fb, wedges, view, ao);
     Image<uint32_t> extra(W, H);
     const Image<uint32_t> emitterExtra = emitterTopUps(stats, kEmitterEdgeSpp);
+    const Image<uint32_t> emitterEdges = emitterTopUps(stats, kEmitterEdgeRays);  // (denseEmission)
     uint64_t extraTotal = 0;
     // Whether an effect's filter at pixel p has outer components on either image axis.
     auto outerComponents = [](const filter::MaafEffect& effect, size_t p) { return effect.pairs(p, 0) > 1 || effect.pairs(p, 1) > 1; };
@@ -288,7 +289,7 @@ void renderMaaf(const MethodContext& ctx, RenderResult& result) {
     textureSamples(ctx, stats, result);
     storeStats(stats, ctx, fb);
     finishLightField(ctx, stats);
-    result.rays += denseEmission(ctx, emitterExtra, fb);
+    result.rays += denseEmission(ctx, emitterEdges, fb);
     result.seconds.add("sampling_adaptive", t.seconds());
 
     // 3b. Without the initial records, the initial samples of the pixels with outer components

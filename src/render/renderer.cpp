@@ -208,6 +208,7 @@ void sampleUniform(const MethodContext& ctx, const std::string& label, RenderRes
     progress.done();
     // Pixels at the edge of a visible emitter get topped up, as in every method.
     const Image<uint32_t> topUp = emitterTopUps(stats, kEmitterEdgeSpp);
+    const Image<uint32_t> edges = emitterTopUps(stats, kEmitterEdgeRays);  // (denseEmission)
     LightFieldStage more(ctx.lightField, [&](size_t p) { return topUp[p]; });
     result.rays += samplePixels(
         ctx.sampler, stats, view,
@@ -216,7 +217,7 @@ void sampleUniform(const MethodContext& ctx, const std::string& label, RenderRes
     if (texture) textureSamples(ctx, stats, result);
     storeStats(stats, ctx, result.buffers);
     finishLightField(ctx, stats);
-    result.rays += denseEmission(ctx, topUp, result.buffers);
+    result.rays += denseEmission(ctx, edges, result.buffers);
     stats = PixelStatsImage();
     result.seconds.add("sampling", t.seconds());
 }
