@@ -181,10 +181,12 @@ Image3f atrousLight(const FrameBuffers& fb, const AtrousParams& params) {
     return atrousFilter(AtrousInput{light, fb.normal, fb.position, fb.footprint, fb.variance}, params);
 }
 
-Image3f atrousFilter(const FrameBuffers& fb, const AtrousParams& params) {
-    Image3f filtered = atrousLight(fb, params);
-    for (size_t i = 0; i < filtered.size(); ++i) filtered[i] = fb.compose(i, filtered[i], Vec3f(0.f));
-    return filtered;
+Image3f atrousCompose(const FrameBuffers& fb, const Image3f& light) {
+    Image3f color(fb.width, fb.height);
+    for (size_t i = 0; i < color.size(); ++i) color[i] = fb.compose(i, light[i], Vec3f(0.f));
+    return color;
 }
+
+Image3f atrousFilter(const FrameBuffers& fb, const AtrousParams& params) { return atrousCompose(fb, atrousLight(fb, params)); }
 
 }  // namespace wedge::filter

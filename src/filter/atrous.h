@@ -120,6 +120,10 @@ Image3f atrousFilter(const AtrousInput& input, const AtrousParams& params);
 /// The primary surfaces' demodulated light (direct + indirect) of `fb`, filtered.
 Image3f atrousLight(const FrameBuffers& fb, const AtrousParams& params);
 
+/// fb.compose of every pixel with `light` as its primary surface's filtered light: emission +
+/// coverage * albedo * light + the unfiltered off-surface samples.
+Image3f atrousCompose(const FrameBuffers& fb, const Image3f& light);
+
 /// The à-trous method on rendered buffers: fb.compose(filter(direct + indirect)), i.e.
 /// emission + coverage * albedo * filtered light + the unfiltered off-surface samples.
 Image3f atrousFilter(const FrameBuffers& fb, const AtrousParams& params);

@@ -134,6 +134,16 @@ inline bool isSharp(float c, float spread, float motion, const LayerOptions& o) 
     return trueBlur < o.sharpShare * (kCellBlur + sqr(o.sigmaMin));
 }
 
+/// Whether a sample's screen motion over the shutter puts it in a motion group (else it is still).
+inline bool movesOnScreen(Vec2f m) { return m.x * m.x + m.y * m.y > kMoving * kMoving; }
+
+/// A sample's defocus slope (pixels per unit of lens radius). A non-finite slope, which no valid
+/// scene gives, counts as in focus: every sample must fall in a slope bin of its class.
+inline float slopeOf(const LightFieldSample& s, const ViewGeometry& view) {
+    const float slope = view.defocusSlope(s.hit() ? s.depth : kInf);
+    return std::isfinite(slope) ? slope : 0.f;
+}
+
 /// The cell of a grid whose cell (i, j) covers the pixel [gx0 + i, gx0 + i + 1) x [gy0 + j, gy0 + j
 /// + 1) (gw x gh cells, row-major) that holds point p; -1 off the grid.
 inline int gridCell(int gx0, int gy0, int gw, int gh, Vec2f p) {
@@ -815,11 +825,7 @@ bool traceBlurred(const Layer& l, int index, Rays& ray, int j0, int j1) {
 
 bool samplesSharpAndStill(const LightFieldSamples& lf, size_t p, const ViewGeometry& view, const LayerOptions& o) {
     bool sharp = true;
-    lf.forEach(p, [&](const LightFieldSample& s) {
-        const Vec2f m = s.motion();
-        const float c = view.defocusSlope(s.hit() ? s.depth : kInf);
-        sharp = sharp && m.x * m.x + m.y * m.y <= kMoving * kMoving && std::isfinite(c) && isSharp(c, 0.f, 0.f, o);
-    });
+    lf.forEach(p, [&](const LightFieldSample& s) { sharp = sharp && !movesOnScreen(s.motion()) && isSharp(slopeOf(s, view), 0.f, 0.f, o); });
     return sharp;
 }
 
@@ -933,12 +939,8 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                             a.t = s.time();
                             a.mx = m.x;
                             a.my = m.y;
-                            const bool moving = m.x * m.x + m.y * m.y > kMoving * kMoving;
-                            a.cls = uint8_t(moving ? 1 + groupOf(m.x, m.y) : 0);
-                            // (A non-finite slope, which no valid scene gives, counts as in
-                            // focus: every sample must fall in a slope bin of its class.)
-                            const float slope = view.defocusSlope(s.hit() ? s.depth : kInf);
-                            a.c = std::isfinite(slope) ? slope : 0.f;
+                            a.cls = uint8_t(movesOnScreen(m) ? 1 + groupOf(m.x, m.y) : 0);
+                            a.c = slopeOf(s, view);
                             a.invDepth = s.hit() ? 1.f / std::max(s.depth, 1e-6f) : 0.f;
                             a.albedo = s.albedo;
                             a.radiance = s.radiance;

@@ -21,8 +21,7 @@ void renderAtrous(const MethodContext& ctx, RenderResult& result) {
         const FrameBuffers& fb = result.buffers;
         const Image3f light = filter::atrousLight(fb, params);
         result.seconds.add("filter", t.seconds());
-        Image3f perPixel(fb.width, fb.height);
-        for (size_t i = 0; i < perPixel.size(); ++i) perPixel[i] = fb.compose(i, light[i], Vec3f(0.f));
+        const Image3f perPixel = filter::atrousCompose(fb, light);
         result.color = reconstructFromLayers(ctx, {&light, nullptr, nullptr}, result, &perPixel);
     } else {
         result.color = filter::atrousFilter(result.buffers, params);

@@ -159,8 +159,7 @@ Image3f reconstructFromLayers(const MethodContext& ctx,
     Image<uint8_t> own;
     Image3f color = filter::reconstructLayers(filter::LayerInput{*ctx.lightField, ctx.view, surfaceLight}, lo, &stats,
                                               perPixel ? &own : nullptr);
-    size_t ownPixels = 0;
-    for (size_t p = 0; perPixel && p < own.size(); ++p) ownPixels += own[p];
+    const size_t ownPixels = size_t(std::count(own.data(), own.data() + own.size(), uint8_t(1)));  // (empty without perPixel)
     parallelRows(fb.height, [&](int y) {
         for (size_t p = size_t(y) * fb.width; p < size_t(y + 1) * fb.width; ++p)
             color[p] = perPixel && own[p] ? (*perPixel)[p] : color[p] + fb.emission[p];
@@ -181,12 +180,11 @@ Image3f composeFilteredLight(const MethodContext& ctx, const Image3f& filteredVi
     const FrameBuffers& fb = result.buffers;
     Image3f direct(fb.width, fb.height);
     for (size_t i = 0; i < direct.size(); ++i) direct[i] = fb.directUnoccluded[i] * filteredVisibility[i].x;
-    if (ctx.lightField) {
-        const std::array<Image3f, 1 + FrameBuffers::kOtherSurfaces> light = fb.surfaceLight(direct, filteredIndirect);
-        const Image3f perPixel = fb.composeFiltered(direct, filteredIndirect);  // as without layers, but the defocus filter
-        return reconstructFromLayers(ctx, {&light[0], &light[1], &light[2]}, result, &perPixel);
-    }
     Image3f color = fb.composeFiltered(direct, filteredIndirect);
+    if (ctx.lightField) {  // the composition is then the pixels' own where their layers are sharp
+        const std::array<Image3f, 1 + FrameBuffers::kOtherSurfaces> light = fb.surfaceLight(direct, filteredIndirect);
+        return reconstructFromLayers(ctx, {&light[0], &light[1], &light[2]}, result, &color);
+    }
     return ctx.view.apertureRadius > 0 ? filter::defocusFilter(color, fb) : color;
 }
 
