@@ -217,9 +217,11 @@ TEST(ExperimentCommand, CachesTheReferenceAndShowsProgressUnlessQuiet) {
                              &out, &err),
               0)
         << err;
-    for (const auto& e : fs::directory_iterator(dir + "/cache"))
-        if (e.path().extension() == ".exr")
+    for (const auto& e : fs::directory_iterator(dir + "/cache")) {
+        if (e.path().extension() == ".exr") {
             EXPECT_EQ(test::readFile(e.path().string()), test::readFile(dirIndependent + "/cache/" + e.path().filename().string()));
+        }
+    }
     // A different resolution is a different reference.
     ASSERT_EQ(test::runWedge(args + "12x12 --quiet", &out, &err), 0) << err;
     cached = 0;

@@ -488,6 +488,51 @@ TEST(Render, ALayeredPixelOnSharpLayersKeepsItsOwnCompositionWithTextureSamples)
     }
 }
 
+TEST(Render, ASharpTexturedPixelOnABlurredLayerKeepsItsOwnComposition) {
+    // A checkered floor receding through the focal plane under a wide lens, --layers on: every
+    // tile's layer is blurred (the floor's |c| spans 0-4 px in each), but the pixels near focus
+    // are sharper than the layer's grid can reconstruct them (|c| below 1.41 px: the ones that
+    // take texture samples). Where such a pixel's rays all end whole on the floor's still layer,
+    // it keeps the method's own composition with its texture samples' albedo. Before, only
+    // pixels whose every layer was sharp did, and the texture samples of the rest went unused:
+    // own pixels 0.66 of the textured ones, relMSE 0.79 of that without texture samples (AAF
+    // and a-trous, seed 5); now 0.90 and 0.66.
+    const scene::Scene s(parse(R"({
+      "camera": {"position": [0, 1, 3], "look_at": [0, 0, 0], "up": [0, 1, 0], "fov_y": 40, "resolution": [96, 64],
+                 "aperture_radius": 0.15, "focus_distance": 3.16},
+      "materials": {"tiles": {"albedo": [0.7, 0.7, 0.7], "texture": "checker", "texture_scale": 4}},
+      "lights": [{"type": "parallelogram", "corner": [-0.5, 3, -0.5], "edge1": [1, 0, 0], "edge2": [0, 0, 1], "radiance": [10, 10, 10]}],
+      "objects": [{"type": "quad", "corner": [-6, 0, -6], "edge1": [0, 0, 12], "edge2": [12, 0, 0], "material": "tiles"}],
+      "render": {"spp": 16, "seed": 5, "indirect": true}
+    })"));
+    render::RenderOptions ro;
+    ro.quiet = true;
+    ro.method = "mc";
+    ro.spp = 1024;
+    ro.layers = "off";
+    ro.seed = 9;
+    const Image3f reference = render::render(s, ro).color;
+    const double pixels = 96.0 * 64.0;
+    for (const char* method : {"aaf", "atrous"}) {
+        render::RenderOptions o;
+        o.quiet = true;
+        o.method = method;
+        o.spp = 16;
+        o.layers = "on";
+        const render::RenderResult with = render::render(s, o);
+        o.textureSpp = 0;
+        const render::RenderResult without = render::render(s, o);
+        EXPECT_EQ(with.figure("layers_blurred_tiles").value_or(0), 1.0) << method;
+        const double textured = with.figure("texture_pixels").value_or(0) / pixels;
+        EXPECT_GT(textured, 0.1) << method;  // the band in focus
+        EXPECT_LT(textured, 0.4) << method;
+        const double own = with.figure("layers_own_pixels").value_or(-1);
+        EXPECT_GT(own, 0.8 * textured) << method;
+        const double e = metrics::relMse(with.color, reference), e0 = metrics::relMse(without.color, reference);
+        EXPECT_LT(e, 0.72 * e0) << method << ": " << e << " against " << e0;
+    }
+}
+
 TEST(Render, AnEmittersEdgeTakesItsDenseEmissionAtAnySampleCountBelowItsRays) {
     // A lamp seen from below, MC without layers: a pixel on its edge takes its emitted light from
     // kEmitterEdgeRays camera rays (denseEmission), the same value at 16 samples a pixel (topped

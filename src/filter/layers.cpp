@@ -829,7 +829,8 @@ bool samplesSharpAndStill(const LightFieldSamples& lf, size_t p, const ViewGeome
     return sharp;
 }
 
-Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStats* stats, Image<uint8_t>* own) {
+Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStats* stats, Image<uint8_t>* own,
+                          const Image<uint8_t>* whole) {
     const LightFieldSamples& lf = in.samples;
     const int W = lf.width(), H = lf.height();
     Image3f out(W, H);
@@ -1271,7 +1272,6 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                             }
                         }
                         int pixelRays = sameForEveryRay ? 1 : rays;
-                        if (own) (*own)(x, y) = sameForEveryRay ? 1 : 0;
                         // The rays are traced a layer at a time, each layer over all the rays it
                         // has not yet stopped (transmittance below 1e-4): per ray the same
                         // front-to-back steps as ray after ray, with the layer's branches and
@@ -1325,12 +1325,18 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                             }
                         };
                         trace(0, pixelRays);
+                        bool straddles = partial;
+                        for (int j = 1; j < pixelRays && !straddles; ++j) straddles = ray.hit[j] != ray.hit[0];
+                        if (own) {
+                            // Rays that all end whole on one still layer show one surface
+                            // (docs/layers.md, "A sharp textured pixel on a blurred layer").
+                            const bool oneStill = !straddles && ray.hit[0] >= 0 && !active[size_t(ray.hit[0])].layer->moving;
+                            (*own)(x, y) = sameForEveryRay || (whole && (*whole)(x, y) && oneStill) ? 1 : 0;
+                        }
                         // A pixel whose rays straddle layers (a defocused or moving silhouette)
                         // takes the rest of the sequence: there the rays' own noise is what
                         // remains (docs/layers.md).
                         if (pixelRays == rays && mixedRays > rays) {
-                            bool straddles = partial;
-                            for (int j = 1; j < rays && !straddles; ++j) straddles = ray.hit[j] != ray.hit[0];
                             if (straddles) {
                                 trace(rays, mixedRays);
                                 pixelRays = mixedRays;

@@ -131,13 +131,18 @@ struct LayerStats {
 /// Whether every sample pixel `p` holds is sharp and still: its defocus blur, a disc of radius
 /// |c|, and its screen motion below the grid's own blur with the smallest Gaussian (the sharp
 /// threshold of a layer whose samples carry filtered light). Where such a pixel's layers in
-/// front are sharp too, the reconstruction is its own samples (reconstructLayers' `own`).
+/// front are sharp too, or its rays all end whole on one still layer, the reconstruction can be
+/// its own (reconstructLayers' `own`).
 bool samplesSharpAndStill(const LightFieldSamples& samples, size_t p, const ViewGeometry& view, const LayerOptions& options = {});
 
 /// The reflected radiance (no emission) of every pixel, reconstructed from the light field.
 /// `own`, where given, is set to 1 in the pixels whose rays all end in sharp still layers (every
-/// ray finds the same values there: the pixel's own samples, composited), 0 elsewhere.
+/// ray finds the same values there: the pixel's own samples, composited) and, among the pixels
+/// `whole` marks (pixels whose samples are sharp and still), in those whose first rays all end
+/// whole (no ray taking part of a layer's coverage) on one still layer, blurred or not: such a
+/// pixel shows one surface, sharper than the layer's grid can reconstruct it, and a caller with
+/// its own estimate of the pixel (its texture samples' mean albedo) takes it there. 0 elsewhere.
 Image3f reconstructLayers(const LayerInput& input, const LayerOptions& options = {}, LayerStats* stats = nullptr,
-                          Image<uint8_t>* own = nullptr);
+                          Image<uint8_t>* own = nullptr, const Image<uint8_t>* whole = nullptr);
 
 }  // namespace wedge::filter

@@ -80,6 +80,7 @@ void textureSamples(const MethodContext& ctx, PixelStatsImage& stats, RenderResu
         return;
     }
     std::atomic<uint64_t> rays{0}, textured{0};
+    if (ctx.lightField) result.texturePixels = Image<uint8_t>(stats.width(), stats.height());
     parallelRows(stats.height(), [&](int y) {
         if (!ctx.sampler.tracesRow(y)) return;
         std::vector<TracedSample> hits(count);
@@ -90,7 +91,10 @@ void textureSamples(const MethodContext& ctx, PixelStatsImage& stats, RenderResu
             // With the layered reconstruction a pixel keeps its own composition only where its
             // samples are sharp and still (reconstructFromLayers); elsewhere its colour is a mean
             // over many pixels' samples, which averages the texture's noise already.
-            if (ctx.lightField && !filter::samplesSharpAndStill(*ctx.lightField, size_t(y) * stats.width() + x, ctx.view)) continue;
+            if (ctx.lightField) {
+                if (!filter::samplesSharpAndStill(*ctx.lightField, size_t(y) * stats.width() + x, ctx.view)) continue;
+                result.texturePixels(x, y) = 1;
+            }
             localRays += ctx.sampler.primaryHits(x, y, ps.n, count, hits.data());
             for (const TracedSample& h : hits) ps.addPrimary(h);
             ++localPixels;
@@ -99,6 +103,8 @@ void textureSamples(const MethodContext& ctx, PixelStatsImage& stats, RenderResu
         textured += localPixels;
     });
     exchangeStats(ctx.sampler.distribution(), stats);
+    if (!result.texturePixels.empty())
+        exchangeImageRows(ctx.sampler.distribution(), result.texturePixels.data(), stats.width(), stats.height());
     result.rays += rays;
     result.extra.emplace_back("texture_pixels", double(textured));
 }
@@ -155,10 +161,16 @@ Image3f reconstructFromLayers(const MethodContext& ctx,
     // Where every ray of a pixel ends in sharp still layers the reconstruction is the pixel's own
     // samples, composited; the method's own composition of the pixel (`perPixel`) is the same
     // estimate with its texture samples' mean albedo (textureSamples) and is taken there.
-    // (docs/layers.md, "A pixel's own composition where its layers are sharp".)
+    // (docs/layers.md, "A pixel's own composition where its layers are sharp".) So it is in a
+    // pixel with texture samples (sharp and still) whose rays all end whole on one still layer,
+    // blurred or not: the layer's grid blurs its texture by at least its smallest Gaussian,
+    // more than the lens does. (docs/layers.md, "A sharp textured pixel on a blurred layer":
+    // taken also in blurred pixels, with texture samples there, it measured worse on a wall 2 px
+    // out of focus, where the grid's blur is the lens's and averages more samples.)
     Image<uint8_t> own;
     Image3f color = filter::reconstructLayers(filter::LayerInput{*ctx.lightField, ctx.view, surfaceLight}, lo, &stats,
-                                              perPixel ? &own : nullptr);
+                                              perPixel ? &own : nullptr,
+                                              result.texturePixels.empty() ? nullptr : &result.texturePixels);
     const size_t ownPixels = size_t(std::count(own.data(), own.data() + own.size(), uint8_t(1)));  // (empty without perPixel)
     parallelRows(fb.height, [&](int y) {
         for (size_t p = size_t(y) * fb.width; p < size_t(y + 1) * fb.width; ++p)
