@@ -440,6 +440,31 @@ TEST(Render, TextureSamplesChangeOnlyTexturedPixelsAndNotWithTheThreads) {
     }
 }
 
+namespace {
+
+/// Plain MC at 1024 spp without layers (seed 9): the reference of the texture tests below.
+Image3f mcReference(const scene::Scene& s) {
+    render::RenderOptions o;
+    o.quiet = true;
+    o.method = "mc";
+    o.spp = 1024;
+    o.layers = "off";
+    o.seed = 9;
+    return render::render(s, o).color;
+}
+
+/// `method` at 16 spp with --layers on.
+render::RenderOptions layeredOptions(const char* method) {
+    render::RenderOptions o;
+    o.quiet = true;
+    o.method = method;
+    o.spp = 16;
+    o.layers = "on";
+    return o;
+}
+
+}  // namespace
+
 TEST(Render, ALayeredPixelOnSharpLayersKeepsItsOwnCompositionWithTextureSamples) {
     // A checkered wall at the focal distance under a lens, a post in front of its left part far
     // out of focus, --layers on. Where every ray of a pixel ends in sharp still layers (the right
@@ -457,19 +482,9 @@ TEST(Render, ALayeredPixelOnSharpLayersKeepsItsOwnCompositionWithTextureSamples)
                   {"type": "box", "min": [-0.7, -0.5, 1.8], "max": [-0.6, 1.5, 1.9], "material": "red"}],
       "render": {"spp": 16, "seed": 5, "indirect": true}
     })"));
-    render::RenderOptions ro;
-    ro.quiet = true;
-    ro.method = "mc";
-    ro.spp = 1024;
-    ro.layers = "off";
-    ro.seed = 9;
-    const Image3f reference = render::render(s, ro).color;
+    const Image3f reference = mcReference(s);
     for (const char* method : {"aaf", "atrous"}) {
-        render::RenderOptions o;
-        o.quiet = true;
-        o.method = method;
-        o.spp = 16;
-        o.layers = "on";
+        render::RenderOptions o = layeredOptions(method);
         const render::RenderResult with = render::render(s, o);
         o.textureSpp = 0;
         const render::RenderResult without = render::render(s, o);
@@ -505,20 +520,10 @@ TEST(Render, ASharpTexturedPixelOnABlurredLayerKeepsItsOwnComposition) {
       "objects": [{"type": "quad", "corner": [-6, 0, -6], "edge1": [0, 0, 12], "edge2": [12, 0, 0], "material": "tiles"}],
       "render": {"spp": 16, "seed": 5, "indirect": true}
     })"));
-    render::RenderOptions ro;
-    ro.quiet = true;
-    ro.method = "mc";
-    ro.spp = 1024;
-    ro.layers = "off";
-    ro.seed = 9;
-    const Image3f reference = render::render(s, ro).color;
+    const Image3f reference = mcReference(s);
     const double pixels = 96.0 * 64.0;
     for (const char* method : {"aaf", "atrous"}) {
-        render::RenderOptions o;
-        o.quiet = true;
-        o.method = method;
-        o.spp = 16;
-        o.layers = "on";
+        render::RenderOptions o = layeredOptions(method);
         const render::RenderResult with = render::render(s, o);
         o.textureSpp = 0;
         const render::RenderResult without = render::render(s, o);
