@@ -823,14 +823,15 @@ bool traceBlurred(const Layer& l, int index, Rays& ray, int j0, int j1) {
 
 }  // namespace
 
-bool samplesSharpAndStill(const LightFieldSamples& lf, size_t p, const ViewGeometry& view, const LayerOptions& o) {
+bool samplesSharpAndStill(const LightFieldSamples& lf, size_t p, const ViewGeometry& view, const LayerOptions& o, int surface) {
     bool sharp = true;
-    lf.forEach(p, [&](const LightFieldSample& s) { sharp = sharp && !movesOnScreen(s.motion()) && isSharp(slopeOf(s, view), 0.f, 0.f, o); });
+    lf.forEach(p, [&](const LightFieldSample& s) {
+        if (surface < 0 || s.surface() == surface) sharp = sharp && !movesOnScreen(s.motion()) && isSharp(slopeOf(s, view), 0.f, 0.f, o);
+    });
     return sharp;
 }
 
-Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStats* stats, Image<uint8_t>* own,
-                          const Image<uint8_t>* whole) {
+Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStats* stats, Image<uint8_t>* own) {
     const LightFieldSamples& lf = in.samples;
     const int W = lf.width(), H = lf.height();
     Image3f out(W, H);
@@ -1129,6 +1130,28 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                                  l.gh,       l.accStride(), l.timeBins, l.sharp,  l.moving,    l.acc.data(),
                                  l.accD.data(), motionAcc[k].empty() ? nullptr : motionAcc[k].data()};
                 }
+                // The layer of each of the tile's textured pixels' surfaces, where all of its
+                // samples there are in one (-2: in several): there a sample in a sharp layer
+                // carries its pixel's mean albedo (LayerInput::surfaceAlbedo). (Without that
+                // test a surface split between two layers inside a pixel gave each part the
+                // whole pixel's albedo: docs/textured.json's floor dark along a checker edge.)
+                const int tw = X1 - X0, th = Y1 - Y0;
+                constexpr int kSurfaces = 1 + FrameBuffers::kOtherSurfaces;
+                std::vector<int16_t> surfaceLayer;
+                auto tilePixel = [&](const Gathered& s) -> int {
+                    const int px = int(s.pixel % uint32_t(W)), py = int(s.pixel / uint32_t(W));
+                    return px >= X0 && px < X1 && py >= Y0 && py < Y1 ? (py - Y0) * tw + (px - X0) : -1;
+                };
+                if (in.textured && in.surfaceAlbedo[0]) {
+                    surfaceLayer.assign(size_t(tw) * th * kSurfaces, -1);
+                    for (const Gathered& s : g) {
+                        const int tp = s.surface >= 0 ? tilePixel(s) : -1;
+                        if (tp < 0 || !(*in.textured)[s.pixel]) continue;
+                        int16_t& k = surfaceLayer[size_t(tp) * kSurfaces + size_t(s.surface)];
+                        const int sl = split.layerOf(s);
+                        k = k == -1 ? int16_t(sl) : k == sl ? k : int16_t(-2);
+                    }
+                }
                 for (const Gathered& s : g) {
                     const int sl = split.layerOf(s);
                     // D of the layers in front, at their shear (as Layer::sharpPosition): where this
@@ -1152,7 +1175,12 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                         float* m = l.motion + size_t(ci) * 3;
                         m[0] += 1.f, m[1] += s.mx, m[2] += s.my;
                     }
-                    const Vec3f radiance = radianceOf(s, l);
+                    Vec3f radiance = radianceOf(s, l);
+                    if (l.sharp && !surfaceLayer.empty() && s.surface >= 0 && in.surfaceLight[s.surface] && in.surfaceAlbedo[s.surface]) {
+                        const int tp = tilePixel(s);
+                        if (tp >= 0 && surfaceLayer[size_t(tp) * kSurfaces + size_t(s.surface)] == sl)
+                            radiance = (*in.surfaceAlbedo[s.surface])[s.pixel] * (*in.surfaceLight[s.surface])[s.pixel];
+                    }
                     float* a = cellAcc + 2 + 4 * timeBinOf(l.timeBins, s.t);
                     a[0] += 1.f;
                     a[1] += radiance.x;
@@ -1331,7 +1359,7 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                             // Rays that all end whole on one still layer show one surface
                             // (docs/layers.md, "A sharp textured pixel on a blurred layer").
                             const bool oneStill = !straddles && ray.hit[0] >= 0 && !active[size_t(ray.hit[0])].layer->moving;
-                            (*own)(x, y) = sameForEveryRay || (whole && (*whole)(x, y) && oneStill) ? 1 : 0;
+                            (*own)(x, y) = sameForEveryRay || (in.textured && ((*in.textured)(x, y) & kTexturePixel) && oneStill) ? 1 : 0;
                         }
                         // A pixel whose rays straddle layers (a defocused or moving silhouette)
                         // takes the rest of the sequence: there the rays' own noise is what

@@ -119,7 +119,20 @@ struct LayerInput {
     /// where that is another point's light, above). Null: the samples on that surface carry
     /// their own radiance.
     std::array<const Image3f*, 1 + FrameBuffers::kOtherSurfaces> surfaceLight{};
+    /// Where the pixels took texture samples (kTextureSurface, kTexturePixel; null: none), and
+    /// the mean albedo of each FrameBuffers surface in its pixel, theirs included. A sample in a
+    /// sharp layer, on a surface of such a pixel whose samples there all lie in that layer,
+    /// carries that mean albedo x its light instead of its own albedo: the same expectation over
+    /// the pixel, from the texture samples' camera rays too (where a defocused occluder in front
+    /// covers part of the pixel, those that pass it are as the path samples that pass it).
+    const Image<uint8_t>* textured = nullptr;
+    std::array<const Image3f*, 1 + FrameBuffers::kOtherSurfaces> surfaceAlbedo{};
 };
+
+/// LayerInput::textured's bits: the pixel took texture samples for a surface whose samples there
+/// are sharp and still (kTextureSurface), and every sample it holds is sharp and still
+/// (kTexturePixel).
+constexpr uint8_t kTextureSurface = 1, kTexturePixel = 2;
 
 struct LayerStats {
     double gatheredPerPixel = 0;  // samples a tile read, per pixel of the image
@@ -133,16 +146,18 @@ struct LayerStats {
 /// threshold of a layer whose samples carry filtered light). Where such a pixel's layers in
 /// front are sharp too, or its rays all end whole on one still layer, the reconstruction can be
 /// its own (reconstructLayers' `own`).
-bool samplesSharpAndStill(const LightFieldSamples& samples, size_t p, const ViewGeometry& view, const LayerOptions& options = {});
+/// With `surface` >= 0, only the samples on that surface (LightFieldSample::surface()).
+bool samplesSharpAndStill(const LightFieldSamples& samples, size_t p, const ViewGeometry& view, const LayerOptions& options = {},
+                          int surface = -1);
 
 /// The reflected radiance (no emission) of every pixel, reconstructed from the light field.
 /// `own`, where given, is set to 1 in the pixels whose rays all end in sharp still layers (every
 /// ray finds the same values there: the pixel's own samples, composited) and, among the pixels
-/// `whole` marks (pixels whose samples are sharp and still), in those whose first rays all end
-/// whole (no ray taking part of a layer's coverage) on one still layer, blurred or not: such a
-/// pixel shows one surface, sharper than the layer's grid can reconstruct it, and a caller with
-/// its own estimate of the pixel (its texture samples' mean albedo) takes it there. 0 elsewhere.
+/// input.textured marks kTexturePixel, in those whose first rays all end whole (no ray taking
+/// part of a layer's coverage) on one still layer, blurred or not: such a pixel shows one
+/// surface, sharper than the layer's grid can reconstruct it, and a caller with its own estimate
+/// of the pixel (its texture samples' mean albedo) takes it there. 0 elsewhere.
 Image3f reconstructLayers(const LayerInput& input, const LayerOptions& options = {}, LayerStats* stats = nullptr,
-                          Image<uint8_t>* own = nullptr, const Image<uint8_t>* whole = nullptr);
+                          Image<uint8_t>* own = nullptr);
 
 }  // namespace wedge::filter

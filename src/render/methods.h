@@ -64,8 +64,9 @@ constexpr uint32_t kMixedSpp = 64;
 
 
 /// Texture samples, in every method that multiplies filtered light by albedo (aaf, maaf, atrous)
-/// where it composes per pixel (with a light field: only in the pixels whose samples are sharp
-/// and still, filter::samplesSharpAndStill, which can keep their own composition there;
+/// where it composes per pixel (with a light field: only in the pixels whose samples on a
+/// textured surface are sharp and still, filter::samplesSharpAndStill, whose sharp layers then
+/// carry the pixel's mean albedo and which can keep their own composition there;
 /// result.texturePixels marks them for reconstructFromLayers): where a
 /// pixel's path samples saw the albedo of a surface vary by more than kTextureVariance
 /// (PixelStats::albedoVariance), options.textureSpp primary hits more (PathSampler::primaryHits:

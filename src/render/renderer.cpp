@@ -89,11 +89,19 @@ void textureSamples(const MethodContext& ctx, PixelStatsImage& stats, RenderResu
             PixelStats& ps = stats(x, y);
             if (ps.albedoVariance() <= kTextureVariance) continue;
             // With the layered reconstruction a pixel keeps its own composition only where its
-            // samples are sharp and still (reconstructFromLayers); elsewhere its colour is a mean
-            // over many pixels' samples, which averages the texture's noise already.
+            // samples are sharp and still (reconstructFromLayers), and a sharp layer's samples
+            // carry their pixel's mean albedo: the pixel takes texture samples where its samples
+            // on a textured surface are sharp and still. Elsewhere its colour is a mean over many
+            // pixels' samples, which averages the texture's noise already.
             if (ctx.lightField) {
-                if (!filter::samplesSharpAndStill(*ctx.lightField, size_t(y) * stats.width() + x, ctx.view)) continue;
-                result.texturePixels(x, y) = 1;
+                const size_t p = size_t(y) * stats.width() + x;
+                const bool whole = filter::samplesSharpAndStill(*ctx.lightField, p, ctx.view);
+                bool surface = whole;
+                for (int k = 0; k < PixelStats::kSlots && !surface; ++k)
+                    surface = ps.slot(k).n > 0 && ps.slot(k).albedoVariance() > kTextureVariance &&
+                              filter::samplesSharpAndStill(*ctx.lightField, p, ctx.view, {}, k);
+                if (!surface) continue;
+                result.texturePixels(x, y) = filter::kTextureSurface | (whole ? filter::kTexturePixel : 0);
             }
             localRays += ctx.sampler.primaryHits(x, y, ps.n, count, hits.data());
             for (const TracedSample& h : hits) ps.addPrimary(h);
@@ -168,9 +176,13 @@ Image3f reconstructFromLayers(const MethodContext& ctx,
     // taken also in blurred pixels, with texture samples there, it measured worse on a wall 2 px
     // out of focus, where the grid's blur is the lens's and averages more samples.)
     Image<uint8_t> own;
-    Image3f color = filter::reconstructLayers(filter::LayerInput{*ctx.lightField, ctx.view, surfaceLight}, lo, &stats,
-                                              perPixel ? &own : nullptr,
-                                              result.texturePixels.empty() ? nullptr : &result.texturePixels);
+    filter::LayerInput input{*ctx.lightField, ctx.view, surfaceLight};
+    if (!result.texturePixels.empty()) {
+        input.textured = &result.texturePixels;
+        input.surfaceAlbedo[0] = &fb.albedo;
+        for (int k = 0; k < FrameBuffers::kOtherSurfaces; ++k) input.surfaceAlbedo[1 + k] = &fb.other[k].albedo;
+    }
+    Image3f color = filter::reconstructLayers(input, lo, &stats, perPixel ? &own : nullptr);
     const size_t ownPixels = size_t(std::count(own.data(), own.data() + own.size(), uint8_t(1)));  // (empty without perPixel)
     parallelRows(fb.height, [&](int y) {
         for (size_t p = size_t(y) * fb.width; p < size_t(y + 1) * fb.width; ++p)
