@@ -558,10 +558,12 @@ TEST(Render, ASharpTexturedPixelOnABlurredLayerKeepsItsOwnComposition) {
     // tile's layer is blurred (the floor's |c| spans 0-4 px in each), but the pixels near focus
     // are sharper than the layer's grid can reconstruct them (|c| below 1.41 px: the ones that
     // take texture samples). Where such a pixel's rays all end whole on the floor's still layer,
-    // it keeps the method's own composition with its texture samples' albedo. Before, only
-    // pixels whose every layer was sharp did, and the texture samples of the rest went unused:
-    // own pixels 0.66 of the textured ones, relMSE 0.79 of that without texture samples (AAF
-    // and a-trous, seed 5); now 0.90 and 0.66.
+    // or touch only layers at its own depth (the floor split between two layers inside it), it
+    // keeps the method's own composition with its texture samples' albedo; so do the sharp
+    // pixels within kTextureReach of it, inside a texel beside its edge. Before, only pixels
+    // whose every layer was sharp did, and the texture samples of the rest went unused: own
+    // pixels 0.66 of the textured ones, relMSE 0.79 of that without texture samples (AAF and
+    // a-trous, seed 5); with whole rays alone 0.90 and 0.61; now 1.40 and 0.49.
     const scene::Scene s(parse(R"({
       "camera": {"position": [0, 1, 3], "look_at": [0, 0, 0], "up": [0, 1, 0], "fov_y": 40, "resolution": [96, 64],
                  "aperture_radius": 0.15, "focus_distance": 3.16},
@@ -579,9 +581,9 @@ TEST(Render, ASharpTexturedPixelOnABlurredLayerKeepsItsOwnComposition) {
         EXPECT_GT(textured, 0.1) << method;  // the band in focus
         EXPECT_LT(textured, 0.4) << method;
         const double own = with.figure("layers_own_pixels").value_or(-1);
-        EXPECT_GT(own, 0.8 * textured) << method;
+        EXPECT_GT(own, 1.2 * textured) << method;
         const double e = metrics::relMse(with.color, reference), e0 = metrics::relMse(without.color, reference);
-        EXPECT_LT(e, 0.72 * e0) << method << ": " << e << " against " << e0;
+        EXPECT_LT(e, 0.55 * e0) << method << ": " << e << " against " << e0;
     }
 }
 

@@ -119,9 +119,9 @@ struct LayerInput {
     /// where that is another point's light, above). Null: the samples on that surface carry
     /// their own radiance.
     std::array<const Image3f*, 1 + FrameBuffers::kOtherSurfaces> surfaceLight{};
-    /// Where the pixels took texture samples (kTextureSurface, kTexturePixel; null: none), and
-    /// the mean albedo of each FrameBuffers surface in its pixel, theirs included. A sample in a
-    /// sharp layer, on a surface of such a pixel whose samples there all lie in that layer,
+    /// Per pixel, kTextureSurface and kSharpTextured (null: none), and the mean albedo of each
+    /// FrameBuffers surface in its pixel, its texture samples' included. A sample in a sharp
+    /// layer, on a surface of a kTextureSurface pixel whose samples there all lie in that layer,
     /// carries that mean albedo x its light instead of its own albedo: the same expectation over
     /// the pixel, from the texture samples' camera rays too (where a defocused occluder in front
     /// covers part of the pixel, those that pass it are as the path samples that pass it).
@@ -130,9 +130,13 @@ struct LayerInput {
 };
 
 /// LayerInput::textured's bits: the pixel took texture samples for a surface whose samples there
-/// are sharp and still (kTextureSurface), and every sample it holds is sharp and still
-/// (kTexturePixel).
-constexpr uint8_t kTextureSurface = 1, kTexturePixel = 2;
+/// are sharp and still (kTextureSurface); every sample it holds is sharp and still, and it or a
+/// pixel within kTextureReach of it took texture samples with every sample sharp and still
+/// (kSharpTextured: a texture's edge the layer's grid would blur more than the lens does).
+constexpr uint8_t kTextureSurface = 1, kSharpTextured = 2;
+/// How far (pixels) kSharpTextured reaches from a pixel with texture samples: the grid's blur
+/// (its smallest Gaussian, sigma 0.5 px, and its cells) carries a texel's edge about that far.
+constexpr int kTextureReach = 2;
 
 struct LayerStats {
     double gatheredPerPixel = 0;  // samples a tile read, per pixel of the image
@@ -153,10 +157,12 @@ bool samplesSharpAndStill(const LightFieldSamples& samples, size_t p, const View
 /// The reflected radiance (no emission) of every pixel, reconstructed from the light field.
 /// `own`, where given, is set to 1 in the pixels whose rays all end in sharp still layers (every
 /// ray finds the same values there: the pixel's own samples, composited) and, among the pixels
-/// input.textured marks kTexturePixel, in those whose first rays all end whole (no ray taking
-/// part of a layer's coverage) on one still layer, blurred or not: such a pixel shows one
-/// surface, sharper than the layer's grid can reconstruct it, and a caller with its own estimate
-/// of the pixel (its texture samples' mean albedo) takes it there. 0 elsewhere.
+/// input.textured marks kSharpTextured, in those whose first rays all end whole (no ray taking
+/// part of a layer's coverage) on one still layer, blurred or not, or touch no layer but still
+/// ones at the pixel's own depth (within 1 px of its samples' mean slope) or behind it: such a
+/// pixel shows one surface (perhaps split between two layers inside it), sharper than the
+/// layer's grid can reconstruct it, and a caller with its own estimate of the pixel (its texture
+/// samples' mean albedo) takes it there. 0 elsewhere.
 Image3f reconstructLayers(const LayerInput& input, const LayerOptions& options = {}, LayerStats* stats = nullptr,
                           Image<uint8_t>* own = nullptr);
 
