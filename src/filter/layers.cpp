@@ -878,7 +878,7 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                     in.samples.forEach(p, [&](const LightFieldSample& s) {
                         c += slopeOf(s, view), inv += s.hit() ? 1.0 / std::max(s.depth, 1e-6f) : 0.0, ++n;
                     });
-                ownDepth[p] = n > 0 ? Vec2f(float(c / n), float(inv / n)) : Vec2f(kInf, 0.f);
+                ownDepth[p] = n > 0 ? Vec2f{float(c / n), float(inv / n)} : Vec2f{kInf, 0.f};
             }
         });
     }
