@@ -8,6 +8,7 @@
 #include "core/parallel.h"
 #include "filter/defocus.h"
 #include "filter/layers.h"
+#include "filter/maaf.h"
 #include "render/distribution.h"
 #include "render/methods.h"
 #include "render/sampling.h"
@@ -111,8 +112,12 @@ void textureSamples(const MethodContext& ctx, PixelStatsImage& stats, RenderResu
         textured += localPixels;
     });
     exchangeStats(ctx.sampler.distribution(), stats);
-    if (!result.texturePixels.empty())
+    if (!result.texturePixels.empty()) {
         exchangeImageRows(ctx.sampler.distribution(), result.texturePixels.data(), stats.width(), stats.height());
+        // None taken (an untextured scene): no mask, and reconstructFromLayers does no texture work.
+        const Image<uint8_t>& m = result.texturePixels;
+        if (std::all_of(m.data(), m.data() + m.size(), [](uint8_t v) { return v == 0; })) result.texturePixels = Image<uint8_t>();
+    }
     result.rays += rays;
     result.extra.emplace_back("texture_pixels", double(textured));
 }
@@ -184,17 +189,12 @@ Image3f reconstructFromLayers(const MethodContext& ctx,
         // the grid's blur carries the edge into it. (Measured, with layers: AAF textured.json
         // 0.000102 -> 0.0000913, a-trous 0.000177 -> 0.000167; docs/layers.md.)
         textured = result.texturePixels;
-        const int W = fb.width, H = fb.height, r = filter::kTextureReach;
-        parallelRows(H, [&](int y) {
-            for (int x = 0; x < W; ++x) {
-                if (textured(x, y) & filter::kSharpTextured) continue;
-                bool near = false;
-                for (int yy = std::max(0, y - r); yy <= std::min(H - 1, y + r) && !near; ++yy)
-                    for (int xx = std::max(0, x - r); xx <= std::min(W - 1, x + r) && !near; ++xx)
-                        near = (result.texturePixels(xx, yy) & filter::kSharpTextured) != 0;
-                if (near && filter::samplesSharpAndStill(*ctx.lightField, size_t(y) * W + x, ctx.view))
-                    textured(x, y) |= filter::kSharpTextured;
-            }
+        Image<uint8_t> sharp(fb.width, fb.height);
+        for (size_t i = 0; i < sharp.size(); ++i) sharp[i] = (textured[i] & filter::kSharpTextured) != 0;
+        const Image<uint8_t> near = filter::dilateBox(sharp, filter::kTextureReach);
+        parallelRows(fb.height, [&](int y) {
+            for (size_t p = size_t(y) * fb.width; p < size_t(y + 1) * fb.width; ++p)
+                if (near[p] && !sharp[p] && filter::samplesSharpAndStill(*ctx.lightField, p, ctx.view)) textured[p] |= filter::kSharpTextured;
         });
         input.textured = &textured;
         input.surfaceAlbedo[0] = &fb.albedo;

@@ -98,7 +98,7 @@ struct RenderResult {
     std::vector<uint64_t> raysPerRank;  // the rays each rank traced ({rays} in one process)
     int threads = 0;
     std::vector<std::pair<std::string, double>> extra;  // method-specific figures for --stats
-    Image<uint8_t> texturePixels;  // with a light field: where a pixel took texture samples (filter::kTextureSurface, kSharpTextured)
+    Image<uint8_t> texturePixels;  // with a light field: where a pixel took texture samples (filter::kTextureSurface, kSharpTextured); empty where none did
     /// The method-specific figure `key`, if the method gave it.
     std::optional<double> figure(const std::string& key) const {
         for (const auto& [k, v] : extra)
