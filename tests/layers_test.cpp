@@ -150,6 +150,28 @@ TEST(LightField, APackedSampleKeepsItsCoordinates) {
     EXPECT_NEAR(t.time(), 0.6f, 1e-4f);
 }
 
+TEST(Layers, BlocksWithoutASilhouetteNearAreLeftToTheMethod) {
+    // One silhouette pixel at (40, 33) in a 100x70 image, blocks of 32, a reach of 2: its own
+    // block (32-63, 32-63) and the one above it (2 rows up is that block's last row) are not
+    // left; the block to its left (9 columns away), every other block and the partial ones at
+    // the image's edges are.
+    Image<uint8_t> mixed(100, 70);
+    mixed(40, 33) = 1;
+    const Image<uint8_t> left = filter::blocksWithoutSilhouettes(mixed, 32, 2);
+    for (int y = 0; y < 70; ++y)
+        for (int x = 0; x < 100; ++x) {
+            const bool kept = x >= 32 && x < 64 && y < 64;
+            EXPECT_EQ(left(x, y), kept ? 0 : 1) << x << ", " << y;
+        }
+    // No silhouette: everything left; a silhouette in every block: nothing.
+    const Image<uint8_t> none = filter::blocksWithoutSilhouettes(Image<uint8_t>(100, 70), 32, 2);
+    EXPECT_TRUE(std::all_of(none.data(), none.data() + none.size(), [](uint8_t v) { return v == 1; }));
+    for (int y = 0; y < 70; y += 16)
+        for (int x = 0; x < 100; x += 16) mixed(x, y) = 1;
+    const Image<uint8_t> all = filter::blocksWithoutSilhouettes(mixed, 32, 2);
+    EXPECT_TRUE(std::all_of(all.data(), all.data() + all.size(), [](uint8_t v) { return v == 0; }));
+}
+
 TEST(Layers, AConstantLightFieldStaysConstantAndEmptyTilesGiveNoNaN) {
     // Two depths under a wide lens (slopes +10 and -4 px) and a moving third, every sample of
     // radiance 0.5; the pixels right of x = 128 have no samples at all (two whole 64-px tiles).

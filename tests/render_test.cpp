@@ -7,6 +7,7 @@
 #include <cstring>
 
 #include "core/parallel.h"
+#include "filter/layers.h"
 #include "metrics/metrics.h"
 #include "render/camera.h"
 #include "render/pixel_stats.h"
@@ -486,6 +487,21 @@ scene::Scene checkeredWall(int textureScale, const std::string& objects) {
     })"));
 }
 
+/// A checkered floor receding through the focal plane under a wide lens (96x64).
+scene::Scene recedingFloor() {
+    return scene::Scene(parse(R"({
+      "camera": {"position": [0, 1, 3], "look_at": [0, 0, 0], "up": [0, 1, 0], "fov_y": 40, "resolution": [96, 64],
+                 "aperture_radius": 0.15, "focus_distance": 3.16},
+      "materials": {"tiles": {"albedo": [0.7, 0.7, 0.7], "texture": "checker", "texture_scale": 4}},
+      "lights": [{"type": "parallelogram", "corner": [-0.5, 3, -0.5], "edge1": [1, 0, 0], "edge2": [0, 0, 1], "radiance": [10, 10, 10]}],
+      "objects": [{"type": "quad", "corner": [-6, 0, -6], "edge1": [0, 0, 12], "edge2": [12, 0, 0], "material": "tiles"}],
+      "render": {"spp": 16, "seed": 5, "indirect": true}
+    })"));
+}
+
+/// A post far out of focus in front of checkeredWall's left part.
+constexpr const char* kPost = R"(, {"type": "box", "min": [-0.7, -0.5, 1.8], "max": [-0.6, 1.5, 1.9], "material": "red"})";
+
 }  // namespace
 
 TEST(Render, ALayeredPixelOnSharpLayersKeepsItsOwnCompositionWithTextureSamples) {
@@ -497,7 +513,7 @@ TEST(Render, ALayeredPixelOnSharpLayersKeepsItsOwnCompositionWithTextureSamples)
     // Before, no texture sample was taken with layers and the wall's checker kept the noise of
     // 16 albedos a pixel: AAF relMSE 0.000334 against 0.000105 now, a-trous 0.000471 against
     // 0.000250 (seed 5).
-    const scene::Scene s = checkeredWall(6, R"(, {"type": "box", "min": [-0.7, -0.5, 1.8], "max": [-0.6, 1.5, 1.9], "material": "red"})");
+    const scene::Scene s = checkeredWall(6, kPost);
     const Image3f reference = mcReference(s);
     for (const char* method : {"aaf", "atrous"}) {
         const auto [with, without] = withAndWithoutTextureSamples(s, method);
@@ -563,18 +579,12 @@ TEST(Render, ASharpTexturedPixelOnABlurredLayerKeepsItsOwnComposition) {
     // pixels within kTextureReach of it, inside a texel beside its edge. Before, only pixels
     // whose every layer was sharp did, and the texture samples of the rest went unused: own
     // pixels 0.66 of the textured ones, relMSE 0.79 of that without texture samples (AAF and
-    // a-trous, seed 5); with whole rays alone 0.90 and 0.61; now 1.40 and 0.49.
-    const scene::Scene s(parse(R"({
-      "camera": {"position": [0, 1, 3], "look_at": [0, 0, 0], "up": [0, 1, 0], "fov_y": 40, "resolution": [96, 64],
-                 "aperture_radius": 0.15, "focus_distance": 3.16},
-      "materials": {"tiles": {"albedo": [0.7, 0.7, 0.7], "texture": "checker", "texture_scale": 4}},
-      "lights": [{"type": "parallelogram", "corner": [-0.5, 3, -0.5], "edge1": [1, 0, 0], "edge2": [0, 0, 1], "radiance": [10, 10, 10]}],
-      "objects": [{"type": "quad", "corner": [-6, 0, -6], "edge1": [0, 0, 12], "edge2": [12, 0, 0], "material": "tiles"}],
-      "render": {"spp": 16, "seed": 5, "indirect": true}
-    })"));
+    // a-trous, seed 5); with whole rays alone 0.90 and 0.61; now 1.40 and 0.49. (Here AAF
+    // leaves every pixel to its own composition: there is no silhouette. The next test.)
+    const scene::Scene s = recedingFloor();
     const Image3f reference = mcReference(s);
     const double pixels = 96.0 * 64.0;
-    for (const char* method : {"aaf", "atrous"}) {
+    for (const char* method : {"atrous"}) {
         const auto [with, without] = withAndWithoutTextureSamples(s, method);
         EXPECT_EQ(with.figure("layers_blurred_tiles").value_or(0), 1.0) << method;
         const double textured = with.figure("texture_pixels").value_or(0) / pixels;
@@ -584,6 +594,64 @@ TEST(Render, ASharpTexturedPixelOnABlurredLayerKeepsItsOwnComposition) {
         EXPECT_GT(own, 1.2 * textured) << method;
         const double e = metrics::relMse(with.color, reference), e0 = metrics::relMse(without.color, reference);
         EXPECT_LT(e, 0.55 * e0) << method << ": " << e << " against " << e0;
+    }
+}
+
+TEST(Render, AFilterKeepsItsOwnImageAwayFromSilhouettes) {
+    // With layers, aaf and maaf leave the blocks of kSilhouetteBlock pixels with no silhouette
+    // within kSilhouetteReach (no pixel whose samples saw several surfaces) to their own
+    // composition, the image they give without layers: the same pixels, bit for bit (the same
+    // samples, texture samples and filters). A checkered floor seen from above through a wide
+    // lens, in focus at the image's centre and blurred towards its top and bottom, has no
+    // silhouette: the whole image. A checkered wall with a post far out of focus in front of its
+    // left part: the blocks the post's blur reaches are reconstructed, the rest are left.
+    const scene::Scene floor(parse(R"({
+      "camera": {"position": [0, 1, 3], "look_at": [0, 0, 1.5], "up": [0, 1, 0], "fov_y": 40, "resolution": [96, 64],
+                 "aperture_radius": 0.15, "focus_distance": 1.8},
+      "materials": {"tiles": {"albedo": [0.7, 0.7, 0.7], "texture": "checker", "texture_scale": 4}},
+      "lights": [{"type": "parallelogram", "corner": [-0.5, 3, -0.5], "edge1": [1, 0, 0], "edge2": [0, 0, 1], "radiance": [10, 10, 10]}],
+      "objects": [{"type": "quad", "corner": [-6, 0, -6], "edge1": [0, 0, 12], "edge2": [12, 0, 0], "material": "tiles"}],
+      "render": {"spp": 16, "seed": 5, "indirect": true}
+    })"));
+    const scene::Scene wall = checkeredWall(6, kPost);
+    for (const char* method : {"aaf", "maaf"}) {
+        render::RenderOptions o = layeredOptions(method);
+        const render::RenderResult on = render::render(floor, o);
+        o.layers = "off";
+        const render::RenderResult off = render::render(floor, o);
+        EXPECT_EQ(on.figure("layers_blurred_tiles").value_or(-1), 0.0) << method;  // none reconstructed
+        EXPECT_EQ(on.figure("layers_method_tiles").value_or(-1), 1.0) << method;
+        EXPECT_EQ(on.figure("layers_own_pixels").value_or(-1), 1.0) << method;
+        EXPECT_EQ(on.figure("texture_pixels"), off.figure("texture_pixels")) << method;
+        EXPECT_TRUE(std::equal(on.color.data(), on.color.data() + on.color.size(), off.color.data())) << method;
+
+        render::RenderOptions w = layeredOptions(method);
+        const render::RenderResult layered = render::render(wall, w);
+        w.layers = "off";
+        const render::RenderResult plain = render::render(wall, w);
+        ASSERT_EQ(layered.methodPixels.size(), layered.color.size()) << method;
+        size_t left = 0, same = 0, silhouette = 0, reconstructed = 0;
+        for (size_t p = 0; p < layered.color.size(); ++p) {
+            const bool equal = layered.color[p] == plain.color[p];
+            if (layered.methodPixels[p]) {
+                ++left;
+                same += equal;
+                continue;
+            }
+            if (plain.buffers.coverage[p] < 0.999f) ++silhouette, reconstructed += !equal;
+            // Near the post: some pixel within the block and the reach saw two surfaces.
+            const int x = int(p % 128), y = int(p / 128), r = filter::kSilhouetteBlock + filter::kSilhouetteReach;
+            bool near = false;
+            for (int yy = std::max(0, y - r); yy <= std::min(31, y + r); ++yy)
+                for (int xx = std::max(0, x - r); xx <= std::min(127, x + r); ++xx) near |= plain.buffers.coverage[size_t(yy) * 128 + xx] < 1.f;
+            EXPECT_TRUE(near) << method << " at " << x << ", " << y;
+        }
+        EXPECT_EQ(same, left) << method;
+        EXPECT_GE(left, layered.color.size() / 4) << method;  // the right part
+        // The post's blur, reconstructed where its rays do not all end on sharp layers (290 of
+        // its 610 pixels; the rest keep the same composition: the first test).
+        EXPECT_GT(silhouette, 200u) << method;
+        EXPECT_GT(reconstructed, silhouette / 3) << method;
     }
 }
 

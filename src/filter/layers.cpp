@@ -831,6 +831,23 @@ bool samplesSharpAndStill(const LightFieldSamples& lf, size_t p, const ViewGeome
     return sharp;
 }
 
+Image<uint8_t> blocksWithoutSilhouettes(const Image<uint8_t>& mixed, int block, int reach) {
+    const int W = mixed.width(), H = mixed.height(), blocksX = (W + block - 1) / block, blocksY = (H + block - 1) / block;
+    Image<uint8_t> out(W, H);
+    parallelRows(blocksY, [&](int by) {  // (a row of blocks)
+        for (int bx = 0; bx < blocksX; ++bx) {
+            const int X0 = bx * block, Y0 = by * block, X1 = std::min(W, X0 + block), Y1 = std::min(H, Y0 + block);
+            bool near = false;
+            for (int y = std::max(0, Y0 - reach); y < std::min(H, Y1 + reach) && !near; ++y)
+                for (int x = std::max(0, X0 - reach); x < std::min(W, X1 + reach) && !near; ++x) near = mixed(x, y) != 0;
+            if (!near)
+                for (int y = Y0; y < Y1; ++y)
+                    for (int x = X0; x < X1; ++x) out(x, y) = 1;
+        }
+    });
+    return out;
+}
+
 Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStats* stats, Image<uint8_t>* own) {
     const LightFieldSamples& lf = in.samples;
     const int W = lf.width(), H = lf.height();
@@ -882,7 +899,7 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
             }
         });
     }
-    std::atomic<uint64_t> gatheredTotal{0}, layerTotal{0}, blurredTotal{0}, straddlingTotal{0};
+    std::atomic<uint64_t> gatheredTotal{0}, layerTotal{0}, blurredTotal{0}, straddlingTotal{0}, leftTotal{0};
     const int apronTiles = (o.maxReach + T - 1) / T;
     const float pad = std::ceil(3.f * o.sigmaMax) + 2.f;
     // Each thread's gathered samples and split, kept across its tiles: a tile's array is tens of
@@ -903,6 +920,20 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
         for (int ty = ty0; ty < ty1; ++ty)
             for (int tx = tx0; tx < tx1; ++tx) {
                 const int X0 = tx * T, Y0 = ty * T, X1 = std::min(W, X0 + T), Y1 = std::min(H, Y0 + T);
+                // The pixels left to the method (LayerInput::methodPixels); a tile of them alone
+                // is not gathered either.
+                const Image<uint8_t>* left = own ? in.methodPixels : nullptr;
+                if (left) {
+                    bool all = true;
+                    for (int y = Y0; y < Y1 && all; ++y)
+                        for (int x = X0; x < X1 && all; ++x) all = (*left)(x, y) != 0;
+                    if (all) {
+                        for (int y = Y0; y < Y1; ++y)
+                            for (int x = X0; x < X1; ++x) out(x, y) = Vec3f(0.f), (*own)(x, y) = 1;
+                        ++leftTotal;
+                        continue;
+                    }
+                }
                 // The reach of the trajectories that can touch this tile.
                 float reachT = 0;
                 for (int sy = std::max(0, ty - apronTiles); sy <= std::min(tilesY - 1, ty + apronTiles); ++sy)
@@ -1280,6 +1311,10 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                 uint64_t straddling = 0;
                 for (int y = Y0; y < Y1; ++y)
                     for (int x = X0; x < X1; ++x) {
+                        if (left && (*left)(x, y)) {
+                            out(x, y) = Vec3f(0.f), (*own)(x, y) = 1;
+                            continue;
+                        }
                         // The rays: a 5D Kronecker sequence (the generalised golden ratio's powers,
                         // Roberts 2018) shifted by a random point per pixel, so that (x, y, u, v,
                         // t) are stratified jointly: a moving edge is a step in x - m t, a
@@ -1423,6 +1458,7 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
         stats->layersPerTile = double(layerTotal) / double(size_t(tilesX) * tilesY);
         stats->blurredTiles = double(blurredTotal) / double(size_t(tilesX) * tilesY);
         stats->straddlingPixels = double(straddlingTotal) / double(std::max<size_t>(1, size_t(W) * H));
+        stats->methodTiles = double(leftTotal) / double(size_t(tilesX) * tilesY);
     }
     return out;
 }

@@ -99,8 +99,8 @@ void finishLightField(const MethodContext& ctx, const PixelStatsImage& stats);
 /// filter/layers.h): each pixel's emission plus the layered reconstruction of the reflected light
 /// from ctx.lightField; with `perPixel` (the method's own composition of each pixel, emission
 /// included), that composition where the reconstruction is the pixel's own samples on sharp
-/// still layers (filter::reconstructLayers' `own`). Times the "layers" stage and adds its figures
-/// to result.extra.
+/// still layers (filter::reconstructLayers' `own`) and in the pixels result.methodPixels leaves to
+/// it. Times the "layers" stage and adds its figures to result.extra.
 Image3f reconstructFromLayers(const MethodContext& ctx, const std::array<const Image3f*, 1 + FrameBuffers::kOtherSurfaces>& surfaceLight,
                               RenderResult& result, const Image3f* perPixel = nullptr);
 
@@ -110,8 +110,8 @@ Image3f visibilityImage(const FrameBuffers& fb);
 /// the filtered visibility (AAF report eq. 3.2), composed with the filtered indirect light
 /// (FrameBuffers::composeFiltered), then, where the camera has a lens, the defocus filter of the
 /// composited radiance (filter/defocus.h).
-/// With ctx.lightField, the layered reconstruction (reconstructFromLayers) takes the place of the
-/// composition and the defocus filter.
+/// With ctx.lightField, the layered reconstruction (reconstructFromLayers) takes the place of that
+/// image near silhouettes (result.methodPixels: filter::blocksWithoutSilhouettes).
 Image3f composeFilteredLight(const MethodContext& ctx, const Image3f& filteredVisibility, const Image3f& filteredIndirect,
                              RenderResult& result);
 

@@ -74,7 +74,35 @@ uint64_t denseEmission(const MethodContext& ctx, const Image<uint32_t>& topUp, F
     return rays;
 }
 
+namespace {
+
+/// result.methodPixels for aaf and maaf with a light field: the blocks of the image with no pixel
+/// within filter::kSilhouetteReach of one whose samples saw several surfaces (a miss counts as
+/// another surface, as in the stage), left to their own composition. Each rank marks its own
+/// rows' pixels, and every rank gets the whole mask. (docs/layers.md, "Blocks without a
+/// silhouette left to the filters".)
+void leaveTilesToTheMethod(const MethodContext& ctx, const PixelStatsImage& stats, RenderResult& result) {
+    if (!ctx.lightField || (ctx.options.method != "aaf" && ctx.options.method != "maaf")) return;
+    const LightFieldSamples& lf = *ctx.lightField;
+    Image<uint8_t> mixed(stats.width(), stats.height());
+    parallelRows(stats.height(), [&](int y) {
+        if (!ctx.sampler.tracesRow(y)) return;
+        for (int x = 0; x < stats.width(); ++x) {
+            const int primary = stats(x, y).primary();
+            const size_t p = size_t(y) * stats.width() + x;
+            lf.forEach(p, [&](const LightFieldSample& s) {
+                if (s.surface() != primary) mixed[p] = 1;
+            });
+        }
+    });
+    exchangeImageRows(ctx.sampler.distribution(), mixed.data(), stats.width(), stats.height());
+    result.methodPixels = filter::blocksWithoutSilhouettes(mixed, filter::kSilhouetteBlock, filter::kSilhouetteReach);
+}
+
+}  // namespace
+
 void textureSamples(const MethodContext& ctx, PixelStatsImage& stats, RenderResult& result) {
+    leaveTilesToTheMethod(ctx, stats, result);
     const uint32_t count = uint32_t(std::max(ctx.options.textureSpp, 0));
     if (count == 0) {
         result.extra.emplace_back("texture_pixels", 0.0);
@@ -94,8 +122,9 @@ void textureSamples(const MethodContext& ctx, PixelStatsImage& stats, RenderResu
             // carry their pixel's mean albedo: the pixel takes texture samples where its samples
             // on a textured surface are sharp and still. Elsewhere its colour is a mean over many
             // pixels' samples, which averages the texture's noise already.
-            if (ctx.lightField) {
-                const size_t p = size_t(y) * stats.width() + x;
+            const size_t p = size_t(y) * stats.width() + x;
+            // (A pixel left to the method takes them as without layers.)
+            if (ctx.lightField && (result.methodPixels.empty() || !result.methodPixels[p])) {
                 const bool whole = filter::samplesSharpAndStill(*ctx.lightField, p, ctx.view);
                 bool surface = whole;
                 for (int k = 0; k < PixelStats::kSlots && !surface; ++k)
@@ -200,6 +229,7 @@ Image3f reconstructFromLayers(const MethodContext& ctx,
         input.surfaceAlbedo[0] = &fb.albedo;
         for (int k = 0; k < FrameBuffers::kOtherSurfaces; ++k) input.surfaceAlbedo[1 + k] = &fb.other[k].albedo;
     }
+    if (perPixel && !result.methodPixels.empty()) input.methodPixels = &result.methodPixels;
     Image3f color = filter::reconstructLayers(input, lo, &stats, perPixel ? &own : nullptr);
     const size_t ownPixels = size_t(std::count(own.data(), own.data() + own.size(), uint8_t(1)));  // (empty without perPixel)
     parallelRows(fb.height, [&](int y) {
@@ -212,6 +242,7 @@ Image3f reconstructFromLayers(const MethodContext& ctx,
     result.extra.emplace_back("layers_per_tile", stats.layersPerTile);
     result.extra.emplace_back("layers_blurred_tiles", stats.blurredTiles);
     result.extra.emplace_back("layers_straddling_pixels", stats.straddlingPixels);
+    if (input.methodPixels) result.extra.emplace_back("layers_method_tiles", stats.methodTiles);
     if (perPixel)
         result.extra.emplace_back("layers_own_pixels", double(ownPixels) / double(std::max<size_t>(1, size_t(fb.width) * fb.height)));
     return color;
@@ -223,11 +254,14 @@ Image3f composeFilteredLight(const MethodContext& ctx, const Image3f& filteredVi
     Image3f direct(fb.width, fb.height);
     for (size_t i = 0; i < direct.size(); ++i) direct[i] = fb.directUnoccluded[i] * filteredVisibility[i].x;
     Image3f color = fb.composeFiltered(direct, filteredIndirect);
-    if (ctx.lightField) {  // the composition is then the pixels' own where their layers are sharp
+    if (ctx.view.apertureRadius > 0) color = filter::defocusFilter(color, fb);
+    if (ctx.lightField) {
+        // The layers where a silhouette is near; elsewhere (result.methodPixels), and in the
+        // pixels whose layers are sharp, this composition.
         const std::array<Image3f, 1 + FrameBuffers::kOtherSurfaces> light = fb.surfaceLight(direct, filteredIndirect);
         return reconstructFromLayers(ctx, {&light[0], &light[1], &light[2]}, result, &color);
     }
-    return ctx.view.apertureRadius > 0 ? filter::defocusFilter(color, fb) : color;
+    return color;
 }
 
 double averageSpp(const FrameBuffers& fb) {

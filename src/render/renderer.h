@@ -99,6 +99,7 @@ struct RenderResult {
     int threads = 0;
     std::vector<std::pair<std::string, double>> extra;  // method-specific figures for --stats
     Image<uint8_t> texturePixels;  // with a light field: where a pixel took texture samples (filter::kTextureSurface, kSharpTextured); empty where none did
+    Image<uint8_t> methodPixels;   // with a light field, for aaf and maaf: the pixels left to their own composition (filter::blocksWithoutSilhouettes); empty otherwise
     /// The method-specific figure `key`, if the method gave it.
     std::optional<double> figure(const std::string& key) const {
         for (const auto& [k, v] : extra)
