@@ -487,11 +487,13 @@ scene::Scene checkeredWall(int textureScale, const std::string& objects) {
     })"));
 }
 
-/// A checkered floor receding through the focal plane under a wide lens (96x64).
-scene::Scene recedingFloor() {
+/// A checkered floor under a wide lens (96x64), seen from a camera at (0, 1, 3) looking at (0, 0,
+/// lookAtZ), in focus at `focus`.
+scene::Scene checkeredFloor(double lookAtZ, double focus) {
     return scene::Scene(parse(R"({
-      "camera": {"position": [0, 1, 3], "look_at": [0, 0, 0], "up": [0, 1, 0], "fov_y": 40, "resolution": [96, 64],
-                 "aperture_radius": 0.15, "focus_distance": 3.16},
+      "camera": {"position": [0, 1, 3], "look_at": [0, 0, )" + std::to_string(lookAtZ) +
+                              R"(], "up": [0, 1, 0], "fov_y": 40, "resolution": [96, 64],
+                 "aperture_radius": 0.15, "focus_distance": )" + std::to_string(focus) + R"(},
       "materials": {"tiles": {"albedo": [0.7, 0.7, 0.7], "texture": "checker", "texture_scale": 4}},
       "lights": [{"type": "parallelogram", "corner": [-0.5, 3, -0.5], "edge1": [1, 0, 0], "edge2": [0, 0, 1], "radiance": [10, 10, 10]}],
       "objects": [{"type": "quad", "corner": [-6, 0, -6], "edge1": [0, 0, 12], "edge2": [12, 0, 0], "material": "tiles"}],
@@ -581,7 +583,7 @@ TEST(Render, ASharpTexturedPixelOnABlurredLayerKeepsItsOwnComposition) {
     // pixels 0.66 of the textured ones, relMSE 0.79 of that without texture samples (AAF and
     // a-trous, seed 5); with whole rays alone 0.90 and 0.61; now 1.40 and 0.49. (Here AAF
     // leaves every pixel to its own composition: there is no silhouette. The next test.)
-    const scene::Scene s = recedingFloor();
+    const scene::Scene s = checkeredFloor(0, 3.16);  // receding to the horizon
     const Image3f reference = mcReference(s);
     const double pixels = 96.0 * 64.0;
     for (const char* method : {"atrous"}) {
@@ -605,15 +607,7 @@ TEST(Render, AFilterKeepsItsOwnImageAwayFromSilhouettes) {
     // lens, in focus at the image's centre and blurred towards its top and bottom, has no
     // silhouette: the whole image. A checkered wall with a post far out of focus in front of its
     // left part: the blocks the post's blur reaches are reconstructed, the rest are left.
-    const scene::Scene floor(parse(R"({
-      "camera": {"position": [0, 1, 3], "look_at": [0, 0, 1.5], "up": [0, 1, 0], "fov_y": 40, "resolution": [96, 64],
-                 "aperture_radius": 0.15, "focus_distance": 1.8},
-      "materials": {"tiles": {"albedo": [0.7, 0.7, 0.7], "texture": "checker", "texture_scale": 4}},
-      "lights": [{"type": "parallelogram", "corner": [-0.5, 3, -0.5], "edge1": [1, 0, 0], "edge2": [0, 0, 1], "radiance": [10, 10, 10]}],
-      "objects": [{"type": "quad", "corner": [-6, 0, -6], "edge1": [0, 0, 12], "edge2": [12, 0, 0], "material": "tiles"}],
-      "render": {"spp": 16, "seed": 5, "indirect": true}
-    })"));
-    const scene::Scene wall = checkeredWall(6, kPost);
+    const scene::Scene floor = checkeredFloor(1.5, 1.8), wall = checkeredWall(6, kPost);
     for (const char* method : {"aaf", "maaf"}) {
         render::RenderOptions o = layeredOptions(method);
         const render::RenderResult on = render::render(floor, o);
