@@ -40,7 +40,7 @@ void addMethodFlags(CLI::App& cmd, render::RenderOptions& r) {
         ->check(numberIn(0, 1 << 16));
     cmd.add_option("--texture-spp", r.textureSpp,
                    "aaf/maaf/atrous: camera rays alone per pixel for the albedo where a pixel's samples saw a texture "
-                   "(default 64; 0: none; not with --layers)")
+                   "(default 64; 0: none; with --layers only where the pixel's samples are sharp and still, or aaf's and maaf's image is their own)")
         ->check(numberIn(0, 1 << 16));
     cmd.add_option("--maaf-components", r.maafComponents, "maaf: filters per 2D/3D subspace (3, 5 or 7; 1: the central, axis-aligned filter alone)")
         ->check(CLI::IsMember({1, 3, 5, 7}));
