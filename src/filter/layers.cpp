@@ -11,6 +11,7 @@
 #include "core/memory.h"
 #include "core/parallel.h"
 #include "core/sampler.h"
+#include "filter/maaf.h"  // dilateBox
 
 namespace wedge::filter {
 
@@ -833,14 +834,15 @@ bool samplesSharpAndStill(const LightFieldSamples& lf, size_t p, const ViewGeome
 
 Image<uint8_t> blocksWithoutSilhouettes(const Image<uint8_t>& mixed, int block, int reach) {
     const int W = mixed.width(), H = mixed.height(), blocksX = (W + block - 1) / block, blocksY = (H + block - 1) / block;
+    const Image<uint8_t> near = dilateBox(mixed, reach);
     Image<uint8_t> out(W, H);
     parallelRows(blocksY, [&](int by) {  // (a row of blocks)
         for (int bx = 0; bx < blocksX; ++bx) {
             const int X0 = bx * block, Y0 = by * block, X1 = std::min(W, X0 + block), Y1 = std::min(H, Y0 + block);
-            bool near = false;
-            for (int y = std::max(0, Y0 - reach); y < std::min(H, Y1 + reach) && !near; ++y)
-                for (int x = std::max(0, X0 - reach); x < std::min(W, X1 + reach) && !near; ++x) near = mixed(x, y) != 0;
-            if (!near)
+            bool any = false;
+            for (int y = Y0; y < Y1 && !any; ++y)
+                for (int x = X0; x < X1 && !any; ++x) any = near(x, y) != 0;
+            if (!any)
                 for (int y = Y0; y < Y1; ++y)
                     for (int x = X0; x < X1; ++x) out(x, y) = 1;
         }

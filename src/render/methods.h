@@ -76,7 +76,9 @@ constexpr uint32_t kMixedSpp = 64;
 /// albedo its camera rays saw, and 16-32 of them leave a checker's pixels noisy
 /// (docs/textures.md). Takes the pixels' sample indices on from their path samples' (the same
 /// seed, the same image on any number of threads or ranks). Adds the rays to result.rays and the
-/// pixels' count to result.extra ("texture_pixels").
+/// pixels' count to result.extra ("texture_pixels"). First, for aaf and maaf with a light field,
+/// marks result.methodPixels (filter::blocksWithoutSilhouettes), where texture samples are taken
+/// as without layers.
 void textureSamples(const MethodContext& ctx, PixelStatsImage& stats, RenderResult& result);
 /// The relative variance of a surface's albedo luminance above which a pixel takes texture samples.
 constexpr float kTextureVariance = 1e-4f;

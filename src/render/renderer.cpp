@@ -81,7 +81,7 @@ namespace {
 /// another surface, as in the stage), left to their own composition. Each rank marks its own
 /// rows' pixels, and every rank gets the whole mask. (docs/layers.md, "Blocks without a
 /// silhouette left to the filters".)
-void leaveTilesToTheMethod(const MethodContext& ctx, const PixelStatsImage& stats, RenderResult& result) {
+void leaveBlocksToTheMethod(const MethodContext& ctx, const PixelStatsImage& stats, RenderResult& result) {
     if (!ctx.lightField || (ctx.options.method != "aaf" && ctx.options.method != "maaf")) return;
     const LightFieldSamples& lf = *ctx.lightField;
     Image<uint8_t> mixed(stats.width(), stats.height());
@@ -102,7 +102,7 @@ void leaveTilesToTheMethod(const MethodContext& ctx, const PixelStatsImage& stat
 }  // namespace
 
 void textureSamples(const MethodContext& ctx, PixelStatsImage& stats, RenderResult& result) {
-    leaveTilesToTheMethod(ctx, stats, result);
+    leaveBlocksToTheMethod(ctx, stats, result);
     const uint32_t count = uint32_t(std::max(ctx.options.textureSpp, 0));
     if (count == 0) {
         result.extra.emplace_back("texture_pixels", 0.0);
