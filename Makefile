@@ -33,7 +33,12 @@ test-sanitize: deps
 	@cmake -S . -B $(SANITIZE_BUILD) -DCMAKE_BUILD_TYPE=Release -DCMAKE_CXX_COMPILER=clang++ \
 	  -DWEDGE_SANITIZE=ON $(CMAKE_FLAGS) >/dev/null
 	@cmake --build $(SANITIZE_BUILD) -j $(JOBS)
-	@cd $(SANITIZE_BUILD) && ctest --output-on-failure -j $(JOBS)
+	@cd $(SANITIZE_BUILD) && ctest --output-on-failure -j $(JOBS) -E '$(SANITIZE_SKIP)'
+
+# Statistical quality tests of whole renders that take 20-110 s each under the sanitizers (9 min
+# of the suite's CPU time on 2 cores): the code they run is run, sanitized, by smaller tests
+# (docs/reliability.md, "Timings"). `make test-sanitize SANITIZE_SKIP=NONE` runs them too.
+SANITIZE_SKIP ?= ^(AafQuality\.(GridsBeatsMonteCarloAtItsAverageSpp|SphereLightPenumbraIsNotOverBlurred|LightsOfTwoSizesStayFiltered|TessellatedLampIsFilteredAsOneLight|PenumbraIsNotOverBlurred|TriangleLightPenumbraIsNotOverBlurred)|MaafQuality\.(TakesAafsSamplesNotOnlyThePapersFocalPlaneOnes|AllEffectsBeatsMonteCarloAtItsAverageSpp|NotWorseThanAafFilterAtEqualSamples|NarrowPenumbraBeatsAafAtItsOwnRates|NarrowPenumbraBeatsAafAtEqualSamples))$$
 
 # libFuzzer targets (fuzz/targets.h, docs/reliability.md): build-fuzz/fuzz/fuzz_<target>.
 FUZZ_BUILD ?= build-fuzz
