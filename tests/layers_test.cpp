@@ -864,3 +864,87 @@ TEST(Layers, AMovingLayerGoesBeforeAStillOneItReachesInFrontOf) {
     const double worst = worstColumn(out, 2, [&](float fx, float, float t) { return inBand(fx, t) ? 1.0 : 0.25; });
     EXPECT_LT(worst, 0.03) << "the largest difference of a column's mean from the shutter average (contrast 0.75)";
 }
+
+namespace {
+
+/// The RMS difference of `out`'s first channel from each pixel's exact shutter average,
+/// value(film x, film y, t) over 16 x 16 film positions and 64 shutter times per pixel.
+template <class ValueFn>
+double rmsFromShutterAverage(const Image3f& out, ValueFn&& value) {
+    double squared = 0;
+    for (int y = 0; y < out.height(); ++y)
+        for (int x = 0; x < out.width(); ++x) {
+            double exact = 0;
+            for (int i = 0; i < 16 * 16; ++i)
+                for (int j = 0; j < 64; ++j)
+                    exact += value(float(x) + (float(i % 16) + 0.5f) / 16.f, float(y) + (float(i / 16) + 0.5f) / 16.f,
+                                   (float(j) + 0.5f) / 64.f);
+            squared += sqr(out(x, y).x - exact / (256.0 * 64));
+        }
+    return std::sqrt(squared / double(out.width() * out.height()));
+}
+
+}  // namespace
+
+TEST(Layers, TwelveObjectsMovingTwelveWaysInOneTileEachKeepTheirMotion) {
+    // Twelve discs (radius 5 px, radiances 0.1 to 1) in one 64-px tile, each moving 12 or 20 px
+    // over the shutter in its own direction (30 degrees apart), over a still wall (0.5): twelve
+    // motions no two of which are within a motion group's tolerance of each other. With eight
+    // groups the last discs' samples joined the group nearest their motion and were reprojected
+    // along a motion not theirs (docs/many-motion.json: twelve spheres moving twelve ways, AAF
+    // with layers 18% above its relMSE without, MC's error in smeared blobs). Each pixel against
+    // its exact shutter average (16 x 16 x 64 points in film and time).
+    constexpr int kDiscs = 12;
+    const float R = 5.f;
+    Vec2f centre[kDiscs], motion[kDiscs];
+    for (int k = 0; k < kDiscs; ++k) {
+        centre[k] = {9.f + 15.f * float(k % 4), 12.f + 20.f * float(k / 4)};
+        const float a = float(k) * float(kPi) / 6.f, m = k % 2 ? 20.f : 12.f;
+        motion[k] = {m * std::cos(a), m * std::sin(a)};
+    }
+    // The nearest disc at (fx, fy, t) (discs further down the list are further away), or -1.
+    auto discAt = [&](float fx, float fy, float t) {
+        for (int k = 0; k < kDiscs; ++k) {
+            const float dx = fx - (centre[k].x + motion[k].x * (t - 0.5f)), dy = fy - (centre[k].y + motion[k].y * (t - 0.5f));
+            if (dx * dx + dy * dy < R * R) return k;
+        }
+        return -1;
+    };
+    auto value = [&](int k) { return k < 0 ? 0.5 : 0.1 + 0.9 * k / (kDiscs - 1.0); };
+    const int W = 64, H = 64;
+    const Image3f out = reconstructRandom(W, H, 3, [&](int x, int y, Vec2f film, float t) {
+        const int k = discAt(float(x) + film.x, float(y) + film.y, t);
+        return LightFieldSample::pack(film, {0.f, 0.f}, t, k < 0 ? 8.f : 3.f + 0.1f * float(k),
+                                      k < 0 ? Vec2f{0.f, 0.f} : motion[k], Vec3f(1.f), Vec3f(float(value(k))), 0);
+    });
+    const double rms = rmsFromShutterAverage(out, [&](float fx, float fy, float t) { return value(discAt(fx, fy, t)); });
+    EXPECT_LT(rms, 0.006) << "the RMS difference of the pixels from their shutter averages (radiances 0.1 to 1; 0.0106 with eight motion groups)";
+}
+
+TEST(Layers, AnObjectMovingInDepthPastAnotherGoesBehindItWhenItIsBehind) {
+    // Two discs (radius 8 px) crossing in one tile over a still wall (0.5): A (radiance 1) moves
+    // 30 px right and away from the camera, from depth 3 to 5; B (0.2) moves 30 px left at depth
+    // 4. They overlap from t = 0.23 to 0.77, A in front before t = 0.5 and behind B after. With
+    // one order over the shutter (A first: its nearest sample is the nearest) A covered B in the
+    // second half too (docs/many-motion.json: a sphere moving away over the trail of one it
+    // passed behind): RMS 0.0237. Ordered bin by bin, 0.0021. Each pixel against its exact
+    // shutter average.
+    const float R = 8.f, cy = 16.f;
+    auto ax = [](float t) { return 17.f + 30.f * t; };
+    auto bx = [](float t) { return 47.f - 30.f * t; };
+    auto depthA = [](float t) { return 3.f + 2.f * t; };
+    auto at = [&](float fx, float fy, float t) {  // 0: A, 1: B, -1: the wall
+        const bool inA = sqr(fx - ax(t)) + sqr(fy - cy) < R * R, inB = sqr(fx - bx(t)) + sqr(fy - cy) < R * R;
+        if (inA && inB) return depthA(t) < 4.f ? 0 : 1;
+        return inA ? 0 : inB ? 1 : -1;
+    };
+    auto value = [](int k) { return k == 0 ? 1.0 : k == 1 ? 0.2 : 0.5; };
+    const Image3f out = reconstructRandom(64, 32, 7, [&](int x, int y, Vec2f film, float t) {
+        const int k = at(float(x) + film.x, float(y) + film.y, t);
+        const float depth = k == 0 ? depthA(t) : k == 1 ? 4.f : 8.f;
+        const Vec2f m = k == 0 ? Vec2f{30.f, 0.f} : k == 1 ? Vec2f{-30.f, 0.f} : Vec2f{0.f, 0.f};
+        return LightFieldSample::pack(film, {0.f, 0.f}, t, depth, m, Vec3f(1.f), Vec3f(float(value(k))), 0);
+    });
+    const double rms = rmsFromShutterAverage(out, [&](float fx, float fy, float t) { return value(at(fx, fy, t)); });
+    EXPECT_LT(rms, 0.006) << "the RMS difference of the pixels from their shutter averages (radiances 0.2 to 1; 0.0237 with one order over the shutter)";
+}

@@ -15,14 +15,16 @@
 //
 // Per screen tile (64 pixels, with an apron as wide as the trajectories that reach it, at most
 // LayerOptions::maxReach):
-// 1. The samples are split into depth layers: still samples and up to eight groups of moving
+// 1. The samples are split into depth layers: still samples and up to sixteen groups of moving
 //    ones of like motion apart (layers.cpp, kMotionGroups), each sorted by defocus slope (which
 //    falls with depth; a moving group whose slope changes over the shutter, an object moving in
 //    depth, by its slope at mid-shutter: layers.cpp, slopeRate); a new layer starts where the slopes spread more than
 //    max(0.5, 0.15 |c|) pixels or jump by half a pixel; consecutive still layers that are each
 //    sharp (below) are one, which composites exactly as they would (at most 16 layers, the
 //    thresholds widened until they fit). Layers are composited in the order of their mean
-//    inverse depth.
+//    inverse depth (a moving one's nearest sample's); two that cross in depth over the shutter,
+//    one of them moving, in the order of each of 8 bins of shutter time (layers.cpp,
+//    kOrderBins), and a sample counts in the D of the layers in front of its own at its time.
 // 2. Per layer, on a 1-pixel grid in its sharp image: N, the layer's samples at their own y; D,
 //    those and the samples of every layer behind it at the layer's shear y = x + c_l u - m_l (t -
 //    1/2) (c_l, m_l its means); W, R, G, B, its samples' radiance at their own y, in 8 bins of
