@@ -70,6 +70,7 @@ constexpr int kOrderBins = 8;
 constexpr float kOrderMargin = 0.01f;
 /// A still layer's depth where a moving layer was seen, in cells of this many pixels.
 constexpr int kOrderCell = 8;
+/// ... from every this-many-th of the tile's gathered samples.
 constexpr size_t kOrderStride = 8;
 /// In a blurred still layer of at least this slope (pixels), the samples of a pixel that saw
 /// several surfaces carry their own light, not their pixel's filtered light (radianceOf).
@@ -1135,7 +1136,6 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                 std::vector<int>& binOrder = local.binOrder;
                 std::vector<int>& binRank = local.binRank;
                 std::vector<float>& binKey = local.binKey;
-                binKey.clear();
                 // (Only where some moving layer and another one are not apart in depth over the
                 // whole shutter: one's farthest sample clearly nearer than the other's nearest.)
                 auto clearly = [](float nearer, float farther) { return nearer > farther * (1.f + kOrderMargin); };
@@ -1263,9 +1263,8 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                         }
                     }
                 }
-                // Whether layer k lies in front of layer l at shutter time t.
+                // (timeOrder) Whether layer k lies in front of layer l at shutter time t.
                 auto inFront = [&](int k, int l, float t) {
-                    if (!timeOrder) return k < l;
                     const int* rank = &binRank[size_t(timeBinOf(kOrderBins, t)) * nLayers];
                     return rank[k] < rank[l];
                 };
