@@ -166,15 +166,28 @@ inline int gridCell(int gx0, int gy0, int gw, int gh, Vec2f p) {
     const int i = int(std::floor(p.x)) - gx0, j = int(std::floor(p.y)) - gy0;
     return i < 0 || j < 0 || i >= gw || j >= gh ? -1 : j * gw + i;
 }
-/// Where sample s lies in the sharp image of slope c and screen motion (mx, my): y = x + c u -
-/// m (t - 1/2) (film y: y - c v - m_y (t - 1/2)).
-inline Vec2f shearOf(const Gathered& s, float c, float mx, float my) {
-    const float dt = s.t - 0.5f;
+/// How far along its screen chord m (its motion from the shutter's open to its close) a point
+/// moving at constant velocity in space is at time s = t - 1/2 from where it is at mid-shutter,
+/// as a multiple of m, where its depth is Z_h (1 + g s) (g: the depth's change over the
+/// shutter, relative to the depth at mid-shutter). Under a pinhole a straight path in space
+/// projects to a straight path on screen, but not at a constant rate: with x = F X / Z, x(s) -
+/// x(0) = w s / (1 + g s) (w the screen velocity at mid-shutter), so the chord is m = w / (1 -
+/// g^2 / 4) and the offset m s (1 - g^2 / 4) / (1 + g s); s itself where g = 0. Moving towards
+/// the camera (g < 0) a point covers more of its chord late in the shutter, moving away early.
+/// (Reprojected along the chord at a constant rate, a sphere moving 1 unit away from a depth of
+/// 3.7 over the shutter, its chord 100 px, put its mid-shutter samples 6 px from its others in
+/// its sharp image: docs/layers.md, "Objects moving in depth: the rate along the chord".)
+[[gnu::always_inline]] inline float alongChord(float s, float g) { return (1.f - 0.25f * g * g) * s / (1.f + g * s); }
+/// Where sample s lies in the sharp image of slope c and screen motion (mx, my) of a surface
+/// whose depth changes at the relative rate g (alongChord): y = x + c u - m a(t) (film y: y - c
+/// v - m_y a(t)), a(t) = alongChord(t - 1/2, g), t - 1/2 where g = 0.
+inline Vec2f shearOf(const Gathered& s, float c, float mx, float my, float g) {
+    const float dt = alongChord(s.t - 0.5f, g);
     return {s.x + c * s.u - mx * dt, s.y - c * s.v - my * dt};
 }
 /// Where sample s lies in a layer's grid: its own position in a sharp layer, else its shear.
-inline Vec2f layerPosition(const Gathered& s, bool sharp, float c, float mx, float my) {
-    return sharp ? Vec2f{s.x, s.y} : shearOf(s, c, mx, my);
+inline Vec2f layerPosition(const Gathered& s, bool sharp, float c, float mx, float my, float g) {
+    return sharp ? Vec2f{s.x, s.y} : shearOf(s, c, mx, my, g);
 }
 /// The time bin of shutter time t among `bins`.
 inline int timeBinOf(int bins, float t) { return std::min(bins - 1, int(t * float(bins))); }
@@ -186,6 +199,9 @@ struct Layer {
     float invDepthMin = kInf;  // of its farthest
     int count = 0;
     bool moving = false;
+    // Its motion group's depth over the shutter, Z_h (1 + depthRate (t - 1/2)) (alongChord; 0
+    // for a still layer, or where the depth does not change measurably).
+    float depthRate = 0;
     // The shear y = x + c u - m (t - 1/2) (film y: y - c v - m_y (t - 1/2)) and the sharp image's filter.
     float c = 0, mx = 0, my = 0, invDepth = 0;
     // The rays' shear, shaped by the grid's own blur (Shaped): a ray at lens point u (unit disc)
@@ -199,8 +215,10 @@ struct Layer {
     float gridBlur = 0;  // the grid's own blur, variance per axis (pixels^2)
     // A blurred moving layer's rays are sheared by motionScale times the screen motion of the
     // surface they find there (motionGrid: per cell the mean motion of the layer's samples,
-    // smoothed; the layer's mean where it has none): a sphere's front moves faster on screen
-    // than its silhouette, and the layer's mean motion stretched its blur (layers.cpp, the splat).
+    // smoothed; where it has none, the affine fit of its samples' motion to their position, so
+    // that a ray past the rim of an object growing or shrinking on screen finds the rim): a
+    // sphere's front moves faster on screen than its silhouette, and the layer's mean motion
+    // stretched its blur (layers.cpp, the splat).
     float motionScale = 1, maxMotion = 0;
     std::vector<float> motionGrid;
     static constexpr int kShearSteps = 8;
@@ -247,9 +265,9 @@ struct Layer {
     int accStride() const { return 2 + 4 * timeBins; }
     int cellStride() const { return 2 + 3 * timeBins; }  // ... and last the samples' mean slope there
 
-    Vec2f sharpPosition(const Gathered& s) const { return layerPosition(s, sharp, c, mx, my); }
+    Vec2f sharpPosition(const Gathered& s) const { return layerPosition(s, sharp, c, mx, my, depthRate); }
     /// The blurred layer's shear of sample s with the screen motion (motionX, motionY).
-    Vec2f sharpPosition(const Gathered& s, float motionX, float motionY) const { return shearOf(s, c, motionX, motionY); }
+    Vec2f sharpPosition(const Gathered& s, float motionX, float motionY) const { return shearOf(s, c, motionX, motionY, depthRate); }
     int cellIndex(Vec2f p) const { return gridCell(gx0, gy0, gw, gh, p); }
     int timeBin(float t) const { return timeBinOf(timeBins, t); }
 
@@ -396,22 +414,53 @@ struct SlopeMoments {
         cc += double(slope) * slope;
     }
 };
-/// The pooled within-cell regression of `count` cells' moments (above).
-float slopeRate(const SlopeMoments* cells, size_t count, const LayerOptions& o) {
-    double sxx = 0, sxy = 0, syy = 0, n = 0, groups = 0;
+/// The within-cell sums of `count` cells' moments (SlopeMoments: a value y against the time t),
+/// pooled: the regression of y on t with an intercept per cell.
+struct PooledRegression {
+    double sxx = 0, sxy = 0, syy = 0, n = 0, groups = 0, sumY = 0, sumT = 0;
+    bool valid() const { return n - groups >= 3 && sxx > 1e-6; }
+    /// The squared standard error of the slope beta.
+    double slopeVariance(double beta) const { return std::max(0.0, syy - beta * sxy) / (n - groups - 1) / sxx; }
+};
+PooledRegression pooledRegression(const SlopeMoments* cells, size_t count) {
+    PooledRegression r;
     for (size_t k = 0; k < count; ++k) {
         const SlopeMoments& m = cells[k];
         if (m.n < 2) continue;
-        sxx += m.tt - m.t * m.t / m.n;
-        sxy += m.ct - m.t * m.c / m.n;
-        syy += m.cc - m.c * m.c / m.n;
-        n += m.n;
-        groups += 1;
+        r.sxx += m.tt - m.t * m.t / m.n;
+        r.sxy += m.ct - m.t * m.c / m.n;
+        r.syy += m.cc - m.c * m.c / m.n;
+        r.n += m.n;
+        r.sumY += m.c;
+        r.sumT += m.t;
+        r.groups += 1;
     }
-    if (n - groups < 3 || !(sxx > 1e-6)) return 0.f;
-    const double beta = sxy / sxx;
-    const double se2 = std::max(0.0, syy - beta * sxy) / (n - groups - 1) / sxx;
-    return std::abs(beta) >= o.splitMin && beta * beta >= 9.0 * se2 ? float(beta) : 0.f;
+    return r;
+}
+/// A motion group's depth over the shutter relative to its depth at mid-shutter (Layer::depthRate,
+/// alongChord): the pooled within-cell regression of its samples' depth on their time (`cells`:
+/// the moments of (depth, time) per cell of the sharp image, where one cell holds one surface
+/// point at its several times), over the depth at mid-shutter. 0 where the regression is not
+/// three standard errors from 0 or the rate is under 2% (the rate along the chord then differs
+/// from uniform by under 1%), so that scenes without motion in depth keep their images.
+float depthRateOf(const SlopeMoments* cells, size_t count) {
+    const PooledRegression r = pooledRegression(cells, count);
+    if (!r.valid()) return 0.f;
+    const double beta = r.sxy / r.sxx;  // depth per shutter
+    const double depthMid = r.sumY / r.n - beta * (r.sumT / r.n - 0.5);
+    if (beta * beta < 9.0 * r.slopeVariance(beta) || !(depthMid > 0)) return 0.f;
+    // (|g| < 2 keeps the depth positive over the shutter; 1.5: a depth 7x at its close what it
+    // is at its open.)
+    const double g = std::clamp(beta / depthMid, -1.5, 1.5);
+    return std::abs(g) >= 0.02 ? float(g) : 0.f;
+}
+
+/// The pooled within-cell regression of `count` cells' moments (above).
+float slopeRate(const SlopeMoments* cells, size_t count, const LayerOptions& o) {
+    const PooledRegression r = pooledRegression(cells, count);
+    if (!r.valid()) return 0.f;
+    const double beta = r.sxy / r.sxx;
+    return std::abs(beta) >= o.splitMin && beta * beta >= 9.0 * r.slopeVariance(beta) ? float(beta) : 0.f;
 }
 
 /// Splits the tile's samples into layers, front to back (see layers.h, step 1).
@@ -425,7 +474,7 @@ float slopeRate(const SlopeMoments* cells, size_t count, const LayerOptions& o) 
 /// docs/motion.json); the splat takes each sample's layer from its bin (Split::layerOf).
 template <class Samples>
 void splitLayers(Samples& g, const SlopeRange (&range)[kClasses], const float (&rate)[kClasses],
-                 const SlopeRange (&splitRange)[kClasses], const LayerOptions& o, Split& split) {
+                 const float (&depthRate)[kClasses], const SlopeRange (&splitRange)[kClasses], const LayerOptions& o, Split& split) {
     auto& hist = split.hist;
     for (int cls = 0; cls < kClasses; ++cls) {
         const SlopeRange& r = splitRange[cls];
@@ -515,6 +564,7 @@ void splitLayers(Samples& g, const SlopeRange (&range)[kClasses], const float (&
         layers.resize(h.base + nLayers);
         for (int k = h.base; k < h.base + nLayers; ++k) {
             layers[k].moving = cls > 0;
+            layers[k].depthRate = depthRate[cls];
             layers[k].sharpRun = h.sharpRun[size_t(k - h.base)] != 0;
         }
         // A layer's statistics are those of its bins (summed bin by bin: the means can differ
@@ -717,6 +767,57 @@ struct Bilinear {
     const int c00 = j0 * l.gw + i0;
     return {{c00, c00 + 1, c00 + l.gw, c00 + l.gw + 1}, {(1 - ax) * (1 - ay), ax * (1 - ay), (1 - ax) * ay, ax * ay}};
 }
+/// The least-squares affine fit m(p) = mean + B (p - centre) of a moving layer's samples' screen
+/// motion to their positions in its sharp image. An object moving in depth grows or shrinks on
+/// screen over the shutter, so its samples' motion spreads radially, about linearly in their
+/// position: a ray at the shutter's open past the rim of its mid-shutter image, where the grid
+/// has no samples, takes the motion the rim would have there and finds the rim (with the
+/// layer's mean motion it missed it: a sphere moving 1 unit away from a depth of 3.7, the
+/// trail's start too bright, docs/layers.md, "Objects moving in depth: the rate along the chord").
+struct AffineMotion {
+    Vec2f mean, centre;
+    float b00 = 0, b01 = 0, b10 = 0, b11 = 0;
+    /// The fit at p, its offset from the mean at most `limit` long.
+    Vec2f at(Vec2f p, float limit) const {
+        const float dx = p.x - centre.x, dy = p.y - centre.y;
+        float ox = b00 * dx + b01 * dy, oy = b10 * dx + b11 * dy;
+        const float len2 = ox * ox + oy * oy;
+        if (len2 > limit * limit) {
+            const float k = limit / std::sqrt(len2);
+            ox *= k, oy *= k;
+        }
+        return {mean.x + ox, mean.y + oy};
+    }
+};
+/// fitMotion of a motion grid's unsmoothed sums (per cell: count, sum of mx, sum of my; gw x gh
+/// cells of 1 pixel), the fit's positions at the cells' centres; `fallback` (with no
+/// gradient) where the samples do not span two dimensions.
+AffineMotion fitMotion(const std::vector<float>& acc, int gw, int gh, Vec2f fallback) {
+    double w = 0, sx = 0, sy = 0, sxx = 0, sxy = 0, syy = 0, smx = 0, smy = 0, sxmx = 0, symx = 0, sxmy = 0, symy = 0;
+    for (int j = 0; j < gh; ++j)
+        for (int i = 0; i < gw; ++i) {
+            const float* m = &acc[(size_t(j) * gw + i) * 3];
+            if (!(m[0] > 0.f)) continue;
+            const double n = m[0], x = i + 0.5, y = j + 0.5;
+            w += n, sx += n * x, sy += n * y, sxx += n * x * x, sxy += n * x * y, syy += n * y * y;
+            smx += m[1], smy += m[2], sxmx += x * m[1], symx += y * m[1], sxmy += x * m[2], symy += y * m[2];
+        }
+    AffineMotion fit;
+    fit.mean = fallback;
+    if (w < 8) return fit;
+    const double cx = sx / w, cy = sy / w, mx = smx / w, my = smy / w;
+    fit.mean = {float(mx), float(my)};
+    fit.centre = {float(cx), float(cy)};
+    // Covariances of the position (xx, xy, yy) and of the motion with it (B = C_mp C_pp^-1).
+    const double cxx = sxx / w - cx * cx, cxy = sxy / w - cx * cy, cyy = syy / w - cy * cy;
+    const double cxmx = sxmx / w - cx * mx, cymx = symx / w - cy * mx, cxmy = sxmy / w - cx * my, cymy = symy / w - cy * my;
+    const double det = cxx * cyy - cxy * cxy;
+    if (!(cxx + cyy > 1.0) || !(det > 1e-4 * sqr(cxx + cyy))) return fit;
+    fit.b00 = float((cxmx * cyy - cymx * cxy) / det), fit.b01 = float((cymx * cxx - cxmx * cxy) / det);
+    fit.b10 = float((cxmy * cyy - cymy * cxy) / det), fit.b11 = float((cymy * cxx - cxmy * cxy) / det);
+    return fit;
+}
+
 /// A moving layer's mean motion (motionGrid) at a bilinear lookup.
 [[gnu::always_inline]] inline Vec2f motionAt(const Layer& l, const Bilinear& b) {
     const float* motion = l.motionGrid.data();
@@ -792,7 +893,7 @@ bool traceBlurred(const Layer& l, int index, Rays& ray, int j0, int j1) {
 #pragma omp simd reduction(| : partial)
     for (int j = j0; j < j1; ++j) {
         const float dt = ray.dt[j];
-        const float st = dt * (1.f + l.rayT2 * 4.f * dt * dt);
+        const float st = alongChord(dt * (1.f + l.rayT2 * 4.f * dt * dt), l.depthRate);
         float mox = l.rayMx * st, moy = l.rayMy * st;
         float cRay = l.rayC + l.rayC2 * ray.u2[j];
         if (kFollow || followMotion) {
@@ -933,6 +1034,7 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
         std::vector<Gathered, UnwrittenAllocator<Gathered>> g;
         Split split;
         std::vector<SlopeMoments> moments;  // per motion group and cell (slopeRate)
+        std::vector<SlopeMoments> depthMoments;  // ... of the depth (depthRateOf)
         std::vector<float> binKey;          // per layer and kOrderBins bin: its nearest sample
         std::vector<int> binOrder, binRank;  // per bin: the layers front to back, each layer's place
         std::vector<uint8_t> before;        // per order bin and pair of layers: the first goes before the second
@@ -1080,9 +1182,9 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                     const Image3f* light = s.surface >= 0 && !own ? in.surfaceLight[s.surface] : nullptr;
                     return light ? unpackRgb9e5(s.albedo) * (*light)[s.pixel] : unpackRgb9e5(s.radiance);
                 };
-                // A motion group's slope over the shutter (slopeRate), and the range of its
-                // samples' slopes at mid-shutter.
-                float rate[kClasses] = {};
+                // A motion group's slope and depth over the shutter (slopeRate, depthRateOf), and
+                // the range of its samples' slopes at mid-shutter.
+                float rate[kClasses] = {}, depthRate[kClasses] = {};
                 SlopeRange splitRange[kClasses];
                 std::copy(range, range + kClasses, splitRange);
                 if (groups > 0) {
@@ -1092,14 +1194,19 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                     const int nx = (rx1 - rx0 + 128) / kRateCell + 1, ny = (ry1 - ry0 + 128) / kRateCell + 1;
                     const size_t cells = size_t(nx) * ny;
                     auto& moments = local.moments;
+                    auto& depthMoments = local.depthMoments;
                     moments.assign(size_t(groups) * cells, SlopeMoments{});
+                    depthMoments.assign(size_t(groups) * cells, SlopeMoments{});
                     for (const Gathered& a : g) {
                         if (a.cls == 0) continue;
-                        const Vec2f p = shearOf(a, a.c, a.mx, a.my);
+                        const Vec2f p = shearOf(a, a.c, a.mx, a.my, 0.f);
                         const int ix = std::clamp(int(std::floor((p.x - float(ox)) / float(kRateCell))), 0, nx - 1);
                         const int iy = std::clamp(int(std::floor((p.y - float(oy)) / float(kRateCell))), 0, ny - 1);
-                        moments[size_t(a.cls - 1) * cells + size_t(iy) * nx + ix].add(a.c, a.t);
+                        const size_t cell = size_t(a.cls - 1) * cells + size_t(iy) * nx + ix;
+                        moments[cell].add(a.c, a.t);
+                        if (a.invDepth > 0.f) depthMoments[cell].add(1.f / a.invDepth, a.t);
                     }
+                    for (int k = 1; k <= groups; ++k) depthRate[k] = depthRateOf(&depthMoments[size_t(k - 1) * cells], cells);
                     bool any = false;
                     for (int k = 1; k <= groups; ++k) any |= (rate[k] = slopeRate(&moments[size_t(k - 1) * cells], cells, o)) != 0.f;
                     if (any) {
@@ -1113,7 +1220,7 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                         }
                     }
                 }
-                splitLayers(g, range, rate, splitRange, o, split);
+                splitLayers(g, range, rate, depthRate, splitRange, o, split);
                 std::vector<Layer>& layers = split.layers;
                 layerTotal += layers.size();
                 // Front to back at each time: where a moving layer passes in depth behind or in
@@ -1288,7 +1395,8 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                     // Past LayerOptions::maxGridMargin (the grid's memory) a layer is not
                     // reprojected: its pixels' own samples, unbiased.
                     const float sigma = std::clamp(o.sigmaScale * std::abs(l.c), o.sigmaMin, o.sigmaMax);
-                    const float gridReach = std::abs(l.c) + 0.5f * motion + 3.f * sigma;  // beyond the tile, the rays' cells
+                    // (A point's offset from its mid-shutter position is at most (1 + |g| / 2) / 2 of its chord: alongChord.)
+                    const float gridReach = std::abs(l.c) + 0.5f * (1.f + 0.5f * std::abs(l.depthRate)) * motion + 3.f * sigma;  // beyond the tile, the rays' cells
                     l.sharp = l.sharpRun || gridReach + 1.f > float(o.maxGridMargin) || isSharp(l.c, spread, motion, o);
                     l.rayC = l.c, l.rayMx = l.mx, l.rayMy = l.my;
                     int lm = 0;
@@ -1347,7 +1455,7 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                 // every sample visits every layer in front of its own); a moving layer with a
                 // motion grid (`motion`) takes its D in the pass below.
                 struct SplatTarget {
-                    float c, mx, my;
+                    float c, mx, my, depthRate;
                     int gx0, gy0, gw, gh, accStride, timeBins;
                     bool sharp, moving;
                     float *acc, *d, *motion;
@@ -1356,7 +1464,7 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                 std::vector<SplatTarget> target(layers.size());
                 for (size_t k = 0; k < layers.size(); ++k) {
                     Layer& l = layers[k];
-                    target[k] = {l.c,        l.mx,         l.my,      l.gx0,     l.gy0,       l.gw,
+                    target[k] = {l.c,        l.mx,         l.my,  l.depthRate,    l.gx0,     l.gy0,       l.gw,
                                  l.gh,       l.accStride(), l.timeBins, l.sharp,  l.moving,    l.acc.data(),
                                  l.accD.data(), motionAcc[k].empty() ? nullptr : motionAcc[k].data()};
                 }
@@ -1391,12 +1499,12 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                         if (reorder && !inFront(k, sl, s.t)) continue;
                         const SplatTarget& l = target[size_t(k)];
                         if (l.motion) continue;
-                        const int ci = l.cellIndex(layerPosition(s, l.sharp, l.c, l.mx, l.my));
+                        const int ci = l.cellIndex(layerPosition(s, l.sharp, l.c, l.mx, l.my, l.depthRate));
                         if (ci >= 0) l.d[ci] += 1.f;
                     }
                     // Its own layer's N, D, W and radiance at its own trajectory's point.
                     const SplatTarget& l = target[size_t(sl)];
-                    const Vec2f own = layerPosition(s, l.sharp, s.c, s.mx, s.my);
+                    const Vec2f own = layerPosition(s, l.sharp, s.c, s.mx, s.my, l.depthRate);
                     const int ci = l.cellIndex(own);
                     if (ci < 0) continue;
                     float* cellAcc = l.acc + size_t(ci) * l.accStride;
@@ -1423,13 +1531,27 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                     for (size_t k = 0; k < layers.size(); ++k) {
                         if (motionAcc[k].empty()) continue;
                         Layer& l = layers[k];
+                        const AffineMotion fit = fitMotion(motionAcc[k], l.gw, l.gh, Vec2f{l.mx, l.my});
                         smooth(motionAcc[k], l.gw, l.gh, 3, l.sigma);
                         l.motionGrid.resize(size_t(l.gw) * l.gh * 2);
-                        float reach = 0;
-                        for (size_t i = 0; i < size_t(l.gw) * l.gh; ++i) {
+                        const size_t cells = size_t(l.gw) * l.gh;
+                        float deviation = 0;  // the largest |cell's motion - the fit's mean| where there are samples
+                        for (size_t i = 0; i < cells; ++i) {
                             float* m = &motionAcc[k][i * 3];
-                            if (m[0] >= 0.05f) m[1] /= m[0], m[2] /= m[0];
-                            else m[1] = l.mx, m[2] = l.my;
+                            if (m[0] < 0.05f) continue;
+                            m[1] /= m[0], m[2] /= m[0];
+                            deviation = std::max(deviation, sqr(m[1] - fit.mean.x) + sqr(m[2] - fit.mean.y));
+                        }
+                        deviation = std::sqrt(deviation);
+                        float reach = 0;
+                        for (size_t i = 0; i < cells; ++i) {
+                            float* m = &motionAcc[k][i * 3];
+                            if (m[0] < 0.05f) {
+                                // No samples here: the fit, within the spread of the motions seen.
+                                const Vec2f p{float(i % size_t(l.gw)) + 0.5f, float(i / size_t(l.gw)) + 0.5f};
+                                const Vec2f m1 = fit.at(p, deviation);
+                                m[1] = m1.x, m[2] = m1.y;
+                            }
                             l.motionGrid[2 * i] = m[1];
                             l.motionGrid[2 * i + 1] = m[2];
                             reach = std::max(reach, m[1] * m[1] + m[2] * m[2]);
@@ -1463,7 +1585,7 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                     l.accD = std::vector<float>();
                     l.buildCovered();
                     l.rayReach = std::max({std::abs(l.cMin), std::abs(l.cMax), std::abs(l.rayC), std::abs(l.rayC + l.rayC2)}) +
-                                 0.5f * std::max(std::sqrt(l.rayMx * l.rayMx + l.rayMy * l.rayMy), l.motionScale * l.maxMotion);
+                                 0.5f * (1.f + 0.5f * std::abs(l.depthRate)) * std::max(std::sqrt(l.rayMx * l.rayMx + l.rayMy * l.rayMy), l.motionScale * l.maxMotion);
                 }
                 // A layer a pixel's rays can see; a sharp still layer is the same for every ray
                 // (its pixel's cell), looked up once.

@@ -11,7 +11,10 @@
 // screen motion over the shutter is m sees the point that, through the lens centre at mid-shutter,
 // lies at y = x + c u - m (t - 1/2): its position in the layer's "sharp" image (film x along the
 // lens's u, film y downward against its v: y_y = y - c v - m_y (t - 1/2)). Samples of one
-// surface collapse there onto a sharp image, so samples of many pixels can be reused.
+// surface collapse there onto a sharp image, so samples of many pixels can be reused. (For a
+// surface moving in depth, t - 1/2 is replaced by the share of its chord m a point moving at
+// constant velocity in space covers by then, which is not proportional to the time under
+// perspective: layers.cpp, alongChord.)
 //
 // Per screen tile (64 pixels, with an apron as wide as the trajectories that reach it, at most
 // LayerOptions::maxReach):
@@ -42,8 +45,9 @@
 //    ray takes each layer's alpha and premultiplied radiance at its shear, with the slope and
 //    the screen motion of the surface it finds there (one fixed-point step: a slanted floor's
 //    slope changes across the tile, and a sphere's front moves faster on screen than its
-//    silhouette; a moving layer keeps its samples' mean motion per cell, and its D counts the
-//    samples behind it at that motion too), shaped so that the grid's own blur (cells,
+//    silhouette; a moving layer keeps its samples' mean motion per cell, where it has none the
+//    affine fit of their motion to their position, and its D counts the samples behind it at
+//    that motion too), shaped so that the grid's own blur (cells,
 //    Gaussian, bilinear lookup) over the rays' disc (segment) gives the true disc's (segment's)
 //    edge profile as nearly as a near-Gaussian allows (rays drawn towards the rim: layers.cpp,
 //    Shaped): C += T alpha L, T *= 1 - alpha.
