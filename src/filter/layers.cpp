@@ -178,6 +178,13 @@ inline int gridCell(int gx0, int gy0, int gw, int gh, Vec2f p) {
 /// 3.7 over the shutter, its chord 100 px, put its mid-shutter samples 6 px from its others in
 /// its sharp image: docs/layers.md, "Objects moving in depth: the rate along the chord".)
 [[gnu::always_inline]] inline float alongChord(float s, float g) { return (1.f - 0.25f * g * g) * s / (1.f + g * s); }
+/// The inverse depth at shutter time t of the nearest point of a moving layer whose nearest
+/// sample has inverse depth invDepthMax and whose depth changes at the rate g (alongChord): that
+/// sample taken at the shutter's open (moving away, g > 0) or close, moved along the rate.
+inline float nearestInvDepthAt(float invDepthMax, float g, float t) {
+    const float s0 = g > 0.f ? -0.5f : 0.5f;
+    return invDepthMax * (1.f + g * s0) / (1.f + g * (t - 0.5f));
+}
 /// Where sample s lies in the sharp image of slope c and screen motion (mx, my) of a surface
 /// whose depth changes at the relative rate g (alongChord): y = x + c u - m a(t) (film y: y - c
 /// v - m_y a(t)), a(t) = alongChord(t - 1/2, g), t - 1/2 where g = 0.
@@ -202,6 +209,7 @@ struct Layer {
     // Its motion group's depth over the shutter, Z_h (1 + depthRate (t - 1/2)) (alongChord; 0
     // for a still layer, or where the depth does not change measurably).
     float depthRate = 0;
+    float nearestInvDepthAt(float t) const { return filter::nearestInvDepthAt(invDepthMax, depthRate, t); }
     // The shear y = x + c u - m (t - 1/2) (film y: y - c v - m_y (t - 1/2)) and the sharp image's filter.
     float c = 0, mx = 0, my = 0, invDepth = 0;
     // The rays' shear, shaped by the grid's own blur (Shaped): a ray at lens point u (unit disc)
@@ -338,6 +346,20 @@ void addBin(Layer& l, const Split::Histogram& h, int b) {
     l.invDepthMin = std::min(l.invDepthMin, h.invMin[b]);
 }
 
+/// What a tile's samples are split into layers by (splitLayers): their defocus slope, which falls
+/// with depth; or, under a pinhole, where every slope is 0, with motion in the tile, their
+/// inverse depth q relative to the moving samples' mean q_m, 3.5 (q / q_m - 1), so that the
+/// split's threshold of half a pixel is about 14% in depth near the moving objects. Without it a
+/// pinhole's still surfaces were one layer whatever their depth, composited in front of a moving
+/// object or behind it as a whole: an object moving behind a post showed through it
+/// (`layers_test Layers.UnderAPinholeAnObjectMovingBehindAPostStaysBehindIt`).
+struct SplitKey {
+    float scale = 0;  // 0: the slope
+    float invReference = 0;  // 1 / q_m
+    float ofInvDepth(float q) const { return scale * (q * invReference - 1.f); }
+    float of(const Gathered& s) const { return scale > 0.f ? ofInvDepth(s.invDepth) : s.c; }
+};
+
 /// Merges consecutive still layers (runs of the histogram `h`'s bins, numbered by slope) that
 /// would each be sharp into one, and renumbers the bins' layers; returns the new count and marks
 /// the merged layers in h.sharpRun. Exact: a sharp layer is looked up at the pixel's own cell,
@@ -354,7 +376,7 @@ void addBin(Layer& l, const Split::Histogram& h, int b) {
 /// of the bunny and behind it were one layer, composited in front of the bunny, and the floor
 /// showed through it: +7% over 35 x 15 pixels; docs/layers.md, "Sharp runs across a moving
 /// layer".)
-int mergeSharpRuns(Split::Histogram& h, int nLayers, const LayerOptions& o, const SlopeRange* moving, int movingCount) {
+int mergeSharpRuns(Split::Histogram& h, int nLayers, const LayerOptions& o, const SlopeRange* moving, int movingCount, const SplitKey& key) {
     std::vector<Layer> st(static_cast<size_t>(nLayers));
     for (int b = 0; b < h.bins; ++b)
         if (h.count[b] > 0) addBin(st[size_t(h.binLayer[b])], h, b);
@@ -368,8 +390,10 @@ int mergeSharpRuns(Split::Histogram& h, int nLayers, const LayerOptions& o, cons
         const double inv = 1.0 / std::max(1, s.count);
         const float mx = float(s.sumMx * inv), my = float(s.sumMy * inv);
         const bool sharp = isSharp(float(s.sumC * inv), s.cMax - s.cMin, std::sqrt(mx * mx + my * my), o);
-        // The run's slopes extended by this layer, and whether a moving layer's fall within them.
-        const float lo = std::min(runLo, s.cMin), hi = std::max(runHi, s.cMax);
+        // The run's slopes (keys) extended by this layer, and whether a moving layer's fall within them.
+        const float keyLo = key.scale > 0.f ? key.ofInvDepth(s.invDepthMin) : s.cMin;
+        const float keyHi = key.scale > 0.f ? key.ofInvDepth(s.invDepthMax) : s.cMax;
+        const float lo = std::min(runLo, keyLo), hi = std::max(runHi, keyHi);
         bool between = false;
         for (int m = 0; m < movingCount; ++m) between |= !moving[m].empty() && moving[m].lo <= hi && moving[m].hi >= lo;
         if (sharp && previousSharp && !between) {
@@ -378,7 +402,7 @@ int mergeSharpRuns(Split::Histogram& h, int nLayers, const LayerOptions& o, cons
         } else {
             ++merged;
             run.push_back(0);
-            runLo = s.cMin, runHi = s.cMax;
+            runLo = keyLo, runHi = keyHi;
         }
         renumber[size_t(k)] = merged - 1;
         previousSharp = sharp;
@@ -474,7 +498,8 @@ float slopeRate(const SlopeMoments* cells, size_t count, const LayerOptions& o) 
 /// docs/motion.json); the splat takes each sample's layer from its bin (Split::layerOf).
 template <class Samples>
 void splitLayers(Samples& g, const SlopeRange (&range)[kClasses], const float (&rate)[kClasses],
-                 const float (&depthRate)[kClasses], const SlopeRange (&splitRange)[kClasses], const LayerOptions& o, Split& split) {
+                 const float (&depthRate)[kClasses], const SlopeRange (&splitRange)[kClasses], const LayerOptions& o, Split& split,
+                 const SplitKey& splitKey) {
     auto& hist = split.hist;
     for (int cls = 0; cls < kClasses; ++cls) {
         const SlopeRange& r = splitRange[cls];
@@ -517,7 +542,7 @@ void splitLayers(Samples& g, const SlopeRange (&range)[kClasses], const float (&
         r = Run{};
     };
     for (Gathered& s : g) {
-        const int b = hist[s.cls].bin(s.c - rate[s.cls] * (s.t - 0.5f));
+        const int b = hist[s.cls].bin((s.cls == 0 ? splitKey.of(s) : s.c) - rate[s.cls] * (s.t - 0.5f));
         s.bin = uint16_t(b);
         Run& r = run[s.cls];
         if (b != r.bin) {
@@ -557,7 +582,7 @@ void splitLayers(Samples& g, const SlopeRange (&range)[kClasses], const float (&
                 last = b;
             }
             h.sharpRun.assign(size_t(nLayers), 0);
-            if (cls == 0 && o.mergeSharp) nLayers = mergeSharpRuns(h, nLayers, o, range + 1, kClasses - 1);
+            if (cls == 0 && o.mergeSharp) nLayers = mergeSharpRuns(h, nLayers, o, range + 1, kClasses - 1, splitKey);
             if (int(layers.size()) + nLayers <= o.maxLayers || nLayers <= 1) break;
         }
         h.base = int(layers.size());
@@ -1138,6 +1163,30 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                 gatheredTotal += g.size();
                 SlopeRange range[kClasses];
                 for (int k = 0; k < kClasses; ++k) range[k] = {lo[k], hi[k]};
+                // Under a pinhole, with motion in the tile, the still samples are split by their
+                // inverse depth (SplitKey), and a run of sharp still layers is cut where the
+                // moving classes' inverse depths fall (keyRange); the moving classes are split
+                // as before (by slope: all 0), since an object cut into slices of depth
+                // composites with seams (AAF +28% on docs/sphere-away.json).
+                SplitKey key;
+                SlopeRange keyRange[kClasses];
+                std::copy(range, range + kClasses, keyRange);
+                if (view.apertureRadius <= 0.f && groups > 0) {
+                    double sum = 0, n = 0;
+                    for (const Gathered& a : g)
+                        if (a.cls != 0 && a.invDepth > 0.f) sum += a.invDepth, n += 1;
+                    if (n > 0 && sum > 0) {
+                        key.scale = 3.5f;
+                        key.invReference = float(n / sum);
+                        for (SlopeRange& r : keyRange) r = SlopeRange{};
+                        for (const Gathered& a : g) {
+                            const float k = key.ofInvDepth(a.invDepth);
+                            keyRange[a.cls].lo = std::min(keyRange[a.cls].lo, k);
+                            keyRange[a.cls].hi = std::max(keyRange[a.cls].hi, k);
+                        }
+                        range[0] = keyRange[0];
+                    }
+                }
                 if (g.empty()) {
                     for (int y = Y0; y < Y1; ++y)
                         for (int x = X0; x < X1; ++x) out(x, y) = Vec3f(0.f);
@@ -1220,7 +1269,7 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                         }
                     }
                 }
-                splitLayers(g, range, rate, depthRate, splitRange, o, split);
+                splitLayers(g, keyRange, rate, depthRate, splitRange, o, split, key);
                 std::vector<Layer>& layers = split.layers;
                 layerTotal += layers.size();
                 // Front to back at each time: where a moving layer passes in depth behind or in
@@ -1455,16 +1504,19 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                 // every sample visits every layer in front of its own); a moving layer with a
                 // motion grid (`motion`) takes its D in the pass below.
                 struct SplatTarget {
-                    float c, mx, my, depthRate;
+                    float c, mx, my, depthRate, invDepthMax;
                     int gx0, gy0, gw, gh, accStride, timeBins;
                     bool sharp, moving;
                     float *acc, *d, *motion;
                     int cellIndex(Vec2f p) const { return gridCell(gx0, gy0, gw, gh, p); }
+                    /// Whether a sample of inverse depth q at time t lies clearly (1%) in front of
+                    /// every point of this moving layer then (Layer::nearestInvDepthAt).
+                    bool inFrontOfAll(float q, float t) const { return moving && q > 1.01f * nearestInvDepthAt(invDepthMax, depthRate, t); }
                 };
                 std::vector<SplatTarget> target(layers.size());
                 for (size_t k = 0; k < layers.size(); ++k) {
                     Layer& l = layers[k];
-                    target[k] = {l.c,        l.mx,         l.my,  l.depthRate,    l.gx0,     l.gy0,       l.gw,
+                    target[k] = {l.c,        l.mx,         l.my,  l.depthRate, l.invDepthMax,   l.gx0,     l.gy0,       l.gw,
                                  l.gh,       l.accStride(), l.timeBins, l.sharp,  l.moving,    l.acc.data(),
                                  l.accD.data(), motionAcc[k].empty() ? nullptr : motionAcc[k].data()};
                 }
@@ -1493,12 +1545,18 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                 for (const Gathered& s : g) {
                     const int sl = split.layerOf(s);
                     // D of the layers in front, at their shear (as Layer::sharpPosition): where this
-                    // sample shows that they do not cover.
+                    // sample shows that they do not cover. Not that of a moving layer it lies in
+                    // front of then (a still post a moving object passes behind, in a tile that
+                    // keeps one order over the shutter since the object is not seen where the post
+                    // hides it): it tells nothing of whether the layer covers there, and counted,
+                    // it took the object's coverage away over the whole shutter (docs/crossing.json
+                    // AAF relMSE -16%: docs/layers.md, "A post a moving object passes behind").
                     const bool reorder = timeOrder && reordered[size_t(sl)];
                     for (int k = 0; k < (reorder ? nLayers : sl); ++k) {
                         if (reorder && !inFront(k, sl, s.t)) continue;
                         const SplatTarget& l = target[size_t(k)];
                         if (l.motion) continue;
+                        if (l.inFrontOfAll(s.invDepth, s.t)) continue;
                         const int ci = l.cellIndex(layerPosition(s, l.sharp, l.c, l.mx, l.my, l.depthRate));
                         if (ci >= 0) l.d[ci] += 1.f;
                     }
@@ -1564,6 +1622,7 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                         for (int k = 0; k < (reorder ? nLayers : sl); ++k) {
                             if (motionAcc[k].empty() || (reorder && !inFront(k, sl, s.t))) continue;
                             Layer& l = layers[k];
+                            if (s.invDepth > 1.01f * l.nearestInvDepthAt(s.t)) continue;  // (SplatTarget::inFrontOfAll)
                             const Vec2f m = motionAt(l, bilinear(l, l.sharpPosition(s)));
                             const int ci = l.cellIndex(l.sharpPosition(s, m.x, m.y));
                             if (ci >= 0) l.accD[ci] += 1.f;
