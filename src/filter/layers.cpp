@@ -1504,19 +1504,21 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                 // every sample visits every layer in front of its own); a moving layer with a
                 // motion grid (`motion`) takes its D in the pass below.
                 struct SplatTarget {
-                    float c, mx, my, depthRate, invDepthMax;
+                    float c, mx, my, depthRate, nearNumerator;  // 1.01 x nearestInvDepthAt's numerator
                     int gx0, gy0, gw, gh, accStride, timeBins;
                     bool sharp, moving;
                     float *acc, *d, *motion;
                     int cellIndex(Vec2f p) const { return gridCell(gx0, gy0, gw, gh, p); }
                     /// Whether a sample of inverse depth q at time t lies clearly (1%) in front of
                     /// every point of this moving layer then (Layer::nearestInvDepthAt).
-                    bool inFrontOfAll(float q, float t) const { return moving && q > 1.01f * nearestInvDepthAt(invDepthMax, depthRate, t); }
+                    /// (q (1 + g (t - 1/2)) against nearestInvDepthAt's numerator: no division.)
+                    bool inFrontOfAll(float q, float t) const { return moving && q * (1.f + depthRate * (t - 0.5f)) > nearNumerator; }
                 };
                 std::vector<SplatTarget> target(layers.size());
                 for (size_t k = 0; k < layers.size(); ++k) {
                     Layer& l = layers[k];
-                    target[k] = {l.c,        l.mx,         l.my,  l.depthRate, l.invDepthMax,   l.gx0,     l.gy0,       l.gw,
+                    const float nearNumerator = 1.01f * l.invDepthMax * (1.f + l.depthRate * (l.depthRate > 0.f ? -0.5f : 0.5f));
+                    target[k] = {l.c,        l.mx,         l.my,  l.depthRate, nearNumerator,   l.gx0,     l.gy0,       l.gw,
                                  l.gh,       l.accStride(), l.timeBins, l.sharp,  l.moving,    l.acc.data(),
                                  l.accD.data(), motionAcc[k].empty() ? nullptr : motionAcc[k].data()};
                 }
