@@ -178,13 +178,19 @@ inline int gridCell(int gx0, int gy0, int gw, int gh, Vec2f p) {
 /// 3.7 over the shutter, its chord 100 px, put its mid-shutter samples 6 px from its others in
 /// its sharp image: docs/layers.md, "Objects moving in depth: the rate along the chord".)
 [[gnu::always_inline]] inline float alongChord(float s, float g) { return (1.f - 0.25f * g * g) * s / (1.f + g * s); }
-/// The inverse depth at shutter time t of the nearest point of a moving layer whose nearest
-/// sample has inverse depth invDepthMax and whose depth changes at the rate g (alongChord): that
-/// sample taken at the shutter's open (moving away, g > 0) or close, moved along the rate.
-inline float nearestInvDepthAt(float invDepthMax, float g, float t) {
-    const float s0 = g > 0.f ? -0.5f : 0.5f;
-    return invDepthMax * (1.f + g * s0) / (1.f + g * (t - 0.5f));
+/// Whether a sample of inverse depth q at shutter time t lies clearly (kOrderMargin) in front of
+/// every point of a moving layer whose nearest sample has inverse depth invDepthMax and whose
+/// depth changes at the rate g. Its nearest point's inverse depth at t is that sample's taken at
+/// the shutter's open (moving away, g > 0) or close, moved along the rate: invDepthMax (1 + g
+/// s0) / (1 + g (t - 1/2)); compared as q (1 + g (t - 1/2)) against the numerator, without a
+/// division.
+inline bool inFrontOfMoving(float invDepthMax, float g, float q, float t) {
+    const float numerator = (1.f + kOrderMargin) * invDepthMax * (1.f + g * (g > 0.f ? -0.5f : 0.5f));
+    return q * (1.f + g * (t - 0.5f)) > numerator;
 }
+/// The largest offset of a point from its mid-shutter position, as a share of its chord, where
+/// its depth changes at the rate g (alongChord): (1 + |g| / 2) / 2.
+inline float chordReach(float g) { return 0.5f * (1.f + 0.5f * std::abs(g)); }
 /// Where sample s lies in the sharp image of slope c and screen motion (mx, my) of a surface
 /// whose depth changes at the relative rate g (alongChord): y = x + c u - m a(t) (film y: y - c
 /// v - m_y a(t)), a(t) = alongChord(t - 1/2, g), t - 1/2 where g = 0.
@@ -209,7 +215,7 @@ struct Layer {
     // Its motion group's depth over the shutter, Z_h (1 + depthRate (t - 1/2)) (alongChord; 0
     // for a still layer, or where the depth does not change measurably).
     float depthRate = 0;
-    float nearestInvDepthAt(float t) const { return filter::nearestInvDepthAt(invDepthMax, depthRate, t); }
+    bool inFrontOfAll(float q, float t) const { return moving && inFrontOfMoving(invDepthMax, depthRate, q, t); }
     // The shear y = x + c u - m (t - 1/2) (film y: y - c v - m_y (t - 1/2)) and the sharp image's filter.
     float c = 0, mx = 0, my = 0, invDepth = 0;
     // The rays' shear, shaped by the grid's own blur (Shaped): a ray at lens point u (unit disc)
@@ -814,8 +820,8 @@ struct AffineMotion {
         return {mean.x + ox, mean.y + oy};
     }
 };
-/// fitMotion of a motion grid's unsmoothed sums (per cell: count, sum of mx, sum of my; gw x gh
-/// cells of 1 pixel), the fit's positions at the cells' centres; `fallback` (with no
+/// The AffineMotion of a motion grid's unsmoothed sums (per cell: count, sum of mx, sum of my;
+/// gw x gh cells of 1 pixel), the fit's positions at the cells' centres; `fallback` (with no
 /// gradient) where the samples do not span two dimensions.
 AffineMotion fitMotion(const std::vector<float>& acc, int gw, int gh, Vec2f fallback) {
     double w = 0, sx = 0, sy = 0, sxx = 0, sxy = 0, syy = 0, smx = 0, smy = 0, sxmx = 0, symx = 0, sxmy = 0, symy = 0;
@@ -1444,8 +1450,7 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                     // Past LayerOptions::maxGridMargin (the grid's memory) a layer is not
                     // reprojected: its pixels' own samples, unbiased.
                     const float sigma = std::clamp(o.sigmaScale * std::abs(l.c), o.sigmaMin, o.sigmaMax);
-                    // (A point's offset from its mid-shutter position is at most (1 + |g| / 2) / 2 of its chord: alongChord.)
-                    const float gridReach = std::abs(l.c) + 0.5f * (1.f + 0.5f * std::abs(l.depthRate)) * motion + 3.f * sigma;  // beyond the tile, the rays' cells
+                    const float gridReach = std::abs(l.c) + chordReach(l.depthRate) * motion + 3.f * sigma;  // beyond the tile, the rays' cells
                     l.sharp = l.sharpRun || gridReach + 1.f > float(o.maxGridMargin) || isSharp(l.c, spread, motion, o);
                     l.rayC = l.c, l.rayMx = l.mx, l.rayMy = l.my;
                     int lm = 0;
@@ -1504,21 +1509,17 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                 // every sample visits every layer in front of its own); a moving layer with a
                 // motion grid (`motion`) takes its D in the pass below.
                 struct SplatTarget {
-                    float c, mx, my, depthRate, nearNumerator;  // 1.01 x nearestInvDepthAt's numerator
+                    float c, mx, my, depthRate, invDepthMax;
                     int gx0, gy0, gw, gh, accStride, timeBins;
                     bool sharp, moving;
                     float *acc, *d, *motion;
                     int cellIndex(Vec2f p) const { return gridCell(gx0, gy0, gw, gh, p); }
-                    /// Whether a sample of inverse depth q at time t lies clearly (1%) in front of
-                    /// every point of this moving layer then (Layer::nearestInvDepthAt).
-                    /// (q (1 + g (t - 1/2)) against nearestInvDepthAt's numerator: no division.)
-                    bool inFrontOfAll(float q, float t) const { return moving && q * (1.f + depthRate * (t - 0.5f)) > nearNumerator; }
+                    bool inFrontOfAll(float q, float t) const { return moving && inFrontOfMoving(invDepthMax, depthRate, q, t); }
                 };
                 std::vector<SplatTarget> target(layers.size());
                 for (size_t k = 0; k < layers.size(); ++k) {
                     Layer& l = layers[k];
-                    const float nearNumerator = 1.01f * l.invDepthMax * (1.f + l.depthRate * (l.depthRate > 0.f ? -0.5f : 0.5f));
-                    target[k] = {l.c,        l.mx,         l.my,  l.depthRate, nearNumerator,   l.gx0,     l.gy0,       l.gw,
+                    target[k] = {l.c,        l.mx,         l.my,  l.depthRate, l.invDepthMax,   l.gx0,     l.gy0,       l.gw,
                                  l.gh,       l.accStride(), l.timeBins, l.sharp,  l.moving,    l.acc.data(),
                                  l.accD.data(), motionAcc[k].empty() ? nullptr : motionAcc[k].data()};
                 }
@@ -1624,7 +1625,7 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                         for (int k = 0; k < (reorder ? nLayers : sl); ++k) {
                             if (motionAcc[k].empty() || (reorder && !inFront(k, sl, s.t))) continue;
                             Layer& l = layers[k];
-                            if (s.invDepth > 1.01f * l.nearestInvDepthAt(s.t)) continue;  // (SplatTarget::inFrontOfAll)
+                            if (l.inFrontOfAll(s.invDepth, s.t)) continue;
                             const Vec2f m = motionAt(l, bilinear(l, l.sharpPosition(s)));
                             const int ci = l.cellIndex(l.sharpPosition(s, m.x, m.y));
                             if (ci >= 0) l.accD[ci] += 1.f;
@@ -1646,7 +1647,7 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                     l.accD = std::vector<float>();
                     l.buildCovered();
                     l.rayReach = std::max({std::abs(l.cMin), std::abs(l.cMax), std::abs(l.rayC), std::abs(l.rayC + l.rayC2)}) +
-                                 0.5f * (1.f + 0.5f * std::abs(l.depthRate)) * std::max(std::sqrt(l.rayMx * l.rayMx + l.rayMy * l.rayMy), l.motionScale * l.maxMotion);
+                                 chordReach(l.depthRate) * std::max(std::sqrt(l.rayMx * l.rayMx + l.rayMy * l.rayMy), l.motionScale * l.maxMotion);
                 }
                 // A layer a pixel's rays can see; a sharp still layer is the same for every ray
                 // (its pixel's cell), looked up once.
