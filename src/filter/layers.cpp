@@ -40,23 +40,16 @@ constexpr float kMoving = 0.5f;
 /// A tile's moving samples fall in at most this many groups of like motion, each split into
 /// layers of its own: samples of one slope but different motion (a slowly moving sphere on a
 /// fast floor at its depth, raster-pan) in one layer share its motion grid, and its rays then
-/// reproject them with a blend of both motions (the sphere's rim doubled). A sample joins the
-/// first group whose first motion is within max(kMotionTolerance px, kMotionToleranceRel x its
-/// length) of its own, else starts one; past the last group it joins the nearest. (Tolerances
-/// 2 px / 25%, 3 / 35%, 4 / 50% and 8 / 100% measured within 3% of each other in relMSE on
-/// raster-pan-like and raster-motion-defocus-like scenes; 4 / 50% the best or level, with the
-/// fewest layers after 8 / 100%: docs/layers.md, "Surfaces moving apart".) Eight groups, not
-/// three: a sphere moving towards the camera spreads its samples' motion radially over several
-/// groups, and with three a box crossing the same tiles joined one of them, the sphere's (AAF
-/// `--layers on` relMSE on docs/fast-motion.json 0.000621 -> 0.000181; of the six other scenes
-/// with motion only raster-pan changed, 0.6-2.2% lower: docs/layers.md, "Motion longer than a tile's reach, and an object moving in depth").
-/// Sixteen, not eight: twelve spheres moving twelve ways (docs/many-motion.json) need 9 to 16 in
-/// a tile, and with eight the rest joined a group not theirs and were reprojected along its
-/// motion: relMSE with layers MC 0.000780 -> 0.000603, AAF 0.000322 -> 0.000165 (without
-/// layers 0.000273); every other scene's image the same bytes (docs/layers.md, "Twelve motions
-/// in a tile").
+/// reproject them with a blend of both motions (the sphere's rim doubled). The groups are the
+/// connected parts of the tile's motion field (groupByMotionField); past the last group a part
+/// joins the group of the nearest mean motion. (Until 2026-11-29 a sample joined the first group
+/// whose first motion was within max(4 px, 50%) of its own: docs/layers.md, "Surfaces moving
+/// apart", and "A held-out bunny moving through slats" for why that changed.) Sixteen, not
+/// eight: twelve spheres moving twelve ways (docs/many-motion.json) need 9 to 16 in a tile,
+/// and with eight the rest joined a group not theirs and were reprojected along its motion:
+/// relMSE with layers MC 0.000780 -> 0.000603, AAF 0.000322 -> 0.000165 (docs/layers.md,
+/// "Twelve motions in a tile").
 constexpr int kMotionGroups = 16;
-constexpr float kMotionTolerance = 4.f, kMotionToleranceRel = 0.5f;
 constexpr int kClasses = 1 + kMotionGroups;
 /// A moving layer keeps its radiance in this many bins of shutter time: a moving surface's
 /// shading changes as it moves (towards or away from a light), and the reconstruction rays take
@@ -235,6 +228,9 @@ struct Layer {
     // stretched its blur (layers.cpp, the splat).
     float motionScale = 1, maxMotion = 0;
     std::vector<float> motionGrid;
+    // The affine fit of its samples' motion to their sharp position (film pixels), m(p) = aff +
+    // affB (p - affC): where a ray or a sample behind starts on the layer (motionShift).
+    float affMx = 0, affMy = 0, affCx = 0, affCy = 0, affB00 = 0, affB01 = 0, affB10 = 0, affB11 = 0;
     static constexpr int kShearSteps = 8;
     float shearFrom = 0, shearScale = 0;  // the table's index: (c - shearFrom) shearScale
     Shaped shearTable[kShearSteps + 1];
@@ -491,6 +487,151 @@ float slopeRate(const SlopeMoments* cells, size_t count, const LayerOptions& o) 
     if (!r.valid()) return 0.f;
     const double beta = r.sxy / r.sxx;
     return std::abs(beta) >= o.splitMin && beta * beta >= 9.0 * r.slopeVariance(beta) ? float(beta) : 0.f;
+}
+
+/// A tile's motion groups as the connected parts of its moving samples' motion field: one
+/// object moving in depth grows or shrinks on screen, its samples' motion fanning out from its
+/// vanishing point, and grouped by distance to a group's first motion it was cut into many
+/// groups (a sphere moving towards the camera into 9, the bunny into 13), each a layer whose
+/// coverage fell off at its border with the next: seams inside the object, where what is
+/// behind it showed through. Here the samples are first clustered by motion within cells of
+/// kFieldCell pixels at their mid-shutter sharp positions (first-fit, within max(kFieldTolerance
+/// px, kFieldToleranceRel x the cluster's first motion)); clusters of neighbouring cells whose
+/// mean motions are within that of each other are one group. Another object moves otherwise
+/// than its neighbour there (else nothing tells them apart), so it stays a group of its own.
+/// Groups past kMotionGroups join the one whose mean motion is nearest theirs. On entry a
+/// moving sample's class is nonzero; on return it is 1 + its group. Returns the groups' count.
+constexpr int kFieldCell = 8;
+constexpr int kCellClusters = 6;
+constexpr float kFieldTolerance = 3.f, kFieldToleranceRel = 0.3f;
+struct FieldScratch {
+    struct Cluster {
+        float n, sx, sy, fx, fy;  // count, motion summed, first motion
+    };
+    std::vector<Cluster> clusters;  // kCellClusters per cell
+    std::vector<uint8_t> used;      // per cell
+    std::vector<int> parent, group;  // per cluster
+};
+inline float fieldTolerance2(float mx, float my) {
+    return sqr(std::max(kFieldTolerance, kFieldToleranceRel * std::sqrt(mx * mx + my * my)));
+}
+template <class Samples>
+int groupByMotionField(Samples& g, int x0, int y0, int x1, int y1, FieldScratch& f, float (&lo)[kClasses], float (&hi)[kClasses]) {
+    const int ox = x0 - 64, oy = y0 - 64;
+    const int nx = (x1 - x0 + 128) / kFieldCell + 1, ny = (y1 - y0 + 128) / kFieldCell + 1;
+    const size_t cells = size_t(nx) * ny;
+    auto cellOf = [&](const Gathered& a) {
+        const float px = a.x + a.c * a.u - a.mx * (a.t - 0.5f), py = a.y - a.c * a.v - a.my * (a.t - 0.5f);
+        const int ix = std::clamp(int(std::floor((px - float(ox)) / float(kFieldCell))), 0, nx - 1);
+        const int iy = std::clamp(int(std::floor((py - float(oy)) / float(kFieldCell))), 0, ny - 1);
+        return size_t(iy) * nx + ix;
+    };
+    f.used.assign(cells, 0);
+    f.clusters.resize(cells * kCellClusters);
+    bool any = false;
+    for (auto& a : g) {
+        if (a.cls == 0) continue;
+        any = true;
+        const size_t cell = cellOf(a);
+        FieldScratch::Cluster* c = &f.clusters[cell * kCellClusters];
+        const int used = f.used[cell];
+        int k = 0, nearest = 0;
+        float best = kInf;
+        for (; k < used; ++k) {
+            const float d2 = sqr(a.mx - c[k].fx) + sqr(a.my - c[k].fy);
+            if (d2 <= fieldTolerance2(c[k].fx, c[k].fy)) break;
+            if (d2 < best) best = d2, nearest = k;
+        }
+        if (k == used) {
+            if (used < kCellClusters) {
+                c[k] = {0.f, 0.f, 0.f, a.mx, a.my};
+                f.used[cell] = uint8_t(used + 1);
+            } else {
+                k = nearest;
+            }
+        }
+        c[k].n += 1.f, c[k].sx += a.mx, c[k].sy += a.my;
+        a.cls = uint8_t(1 + k);
+    }
+    if (!any) return 0;
+    f.parent.resize(cells * kCellClusters);
+    for (size_t i = 0; i < f.parent.size(); ++i) f.parent[i] = int(i);
+    auto find = [&](int i) {
+        while (f.parent[size_t(i)] != i) i = f.parent[size_t(i)] = f.parent[size_t(f.parent[size_t(i)])];
+        return i;
+    };
+    auto mean = [&](size_t i) { return Vec2f{f.clusters[i].sx / f.clusters[i].n, f.clusters[i].sy / f.clusters[i].n}; };
+    for (int iy = 0; iy < ny; ++iy)
+        for (int ix = 0; ix < nx; ++ix) {
+            const size_t cell = size_t(iy) * nx + ix;
+            for (int ka = 0; ka < f.used[cell]; ++ka) {
+                const size_t ia = cell * kCellClusters + size_t(ka);
+                const Vec2f ma = mean(ia);
+                const float tolA = fieldTolerance2(ma.x, ma.y);
+                const int nb[5][2] = {{0, 0}, {1, 0}, {-1, 1}, {0, 1}, {1, 1}};
+                for (const auto& d : nb) {
+                    const int jx = ix + d[0], jy = iy + d[1];
+                    if (jx < 0 || jx >= nx || jy >= ny) continue;
+                    const size_t other = size_t(jy) * nx + jx;
+                    for (int kb = other == cell ? ka + 1 : 0; kb < f.used[other]; ++kb) {
+                        const size_t ib = other * kCellClusters + size_t(kb);
+                        const Vec2f mb = mean(ib);
+                        const float d2 = sqr(ma.x - mb.x) + sqr(ma.y - mb.y);
+                        if (d2 > std::max(tolA, fieldTolerance2(mb.x, mb.y))) continue;
+                        const int ra = find(int(ia)), rb = find(int(ib));
+                        if (ra != rb) f.parent[size_t(std::max(ra, rb))] = std::min(ra, rb);
+                    }
+                }
+            }
+        }
+    // Groups in the order of their first cluster (cell by cell), their mean motions.
+    f.group.assign(cells * kCellClusters, -1);
+    double gx[kMotionGroups] = {}, gy[kMotionGroups] = {}, gn[kMotionGroups] = {};
+    int groups = 0;
+    std::vector<int> overflow;
+    for (size_t cell = 0; cell < cells; ++cell)
+        for (int k = 0; k < f.used[cell]; ++k) {
+            const size_t i = cell * kCellClusters + size_t(k);
+            const int r = find(int(i));
+            int& id = f.group[size_t(r)];
+            if (id == -1) {
+                if (groups < kMotionGroups) id = groups++;
+                else id = -2 - int(overflow.size()), overflow.push_back(r);
+            }
+            if (id >= 0) gx[id] += f.clusters[i].sx, gy[id] += f.clusters[i].sy, gn[id] += f.clusters[i].n;
+        }
+    if (!overflow.empty()) {
+        // Each overflowing group's mean motion, then the nearest kept group's.
+        std::vector<Vec2f> sum(overflow.size(), Vec2f{0.f, 0.f});
+        std::vector<float> n(overflow.size(), 0.f);
+        for (size_t cell = 0; cell < cells; ++cell)
+            for (int k = 0; k < f.used[cell]; ++k) {
+                const size_t i = cell * kCellClusters + size_t(k);
+                const int id = f.group[size_t(find(int(i)))];
+                if (id >= 0) continue;
+                const size_t o = size_t(-2 - id);
+                sum[o].x += f.clusters[i].sx, sum[o].y += f.clusters[i].sy, n[o] += f.clusters[i].n;
+            }
+        for (size_t o = 0; o < overflow.size(); ++o) {
+            const Vec2f m{sum[o].x / n[o], sum[o].y / n[o]};
+            int nearest = 0;
+            float best = kInf;
+            for (int k = 0; k < groups; ++k) {
+                const float d2 = sqr(m.x - float(gx[k] / gn[k])) + sqr(m.y - float(gy[k] / gn[k]));
+                if (d2 < best) best = d2, nearest = k;
+            }
+            f.group[size_t(overflow[o])] = nearest;
+        }
+    }
+    for (int k = 1; k < kClasses; ++k) lo[k] = kInf, hi[k] = -kInf;
+    for (auto& a : g) {
+        if (a.cls == 0) continue;
+        const size_t i = cellOf(a) * kCellClusters + size_t(a.cls - 1);
+        a.cls = uint8_t(1 + f.group[size_t(find(int(i)))]);
+        lo[a.cls] = std::min(lo[a.cls], a.c);
+        hi[a.cls] = std::max(hi[a.cls], a.c);
+    }
+    return groups;
 }
 
 /// Splits the tile's samples into layers, front to back (see layers.h, step 1).
@@ -915,6 +1056,24 @@ struct Rays {
 /// same order, as one SIMD loop (its images the same to float rounding, docs/layers.md): every
 /// lane is computed, and a stopped ray's results are not stored. Returns whether a ray took
 /// part of the layer's coverage.
+/// Where a ray (or a sample behind the layer, for D) meets a layer with a motion grid: the
+/// point p of its sharp image with q = p + s m(p), q the ray's point sheared by the lens alone
+/// and s its shutter offset along the chord (alongChord, times motionScale for a ray). Solved
+/// for the affine fit of the layer's motion, (I + s B) p = q - s (m0 - B c), and returned as the
+/// shift s m(p); the caller then takes one step on the grid's own motion at q minus that shift.
+/// From the layer's mean motion one step missed where the motion varies across the layer (an
+/// object moving in depth grows or shrinks on screen, and since groupByMotionField it is one
+/// layer): AAF relMSE with the affine start -26% on docs/sphere-away.json, -8% on
+/// docs/many-motion.json, the same as three fixed-point steps from the mean motion at a third
+/// of their cost (docs/layers.md, "A held-out bunny moving through slats").
+[[gnu::always_inline]] inline Vec2f motionShift(const Layer& l, float qx, float qy, float s, Vec2f fallback) {
+    const float a00 = 1.f + s * l.affB00, a01 = s * l.affB01, a10 = s * l.affB10, a11 = 1.f + s * l.affB11;
+    const float rx = qx - s * (l.affMx - (l.affB00 * l.affCx + l.affB01 * l.affCy));
+    const float ry = qy - s * (l.affMy - (l.affB10 * l.affCx + l.affB11 * l.affCy));
+    const float det = a00 * a11 - a01 * a10;
+    const bool solvable = det > 0.2f;  // (a fit that folds the layer over itself within the shutter: the mean motion's shift)
+    return {solvable ? qx - (a11 * rx - a01 * ry) / det : fallback.x, solvable ? qy - (a00 * ry - a10 * rx) / det : fallback.y};
+}
 template <bool kFollow, bool kMoving>
 bool traceBlurred(const Layer& l, int index, Rays& ray, int j0, int j1) {
     const int cs = l.cellStride(), bins = l.timeBins;
@@ -927,6 +1086,10 @@ bool traceBlurred(const Layer& l, int index, Rays& ray, int j0, int j1) {
         const float st = alongChord(dt * (1.f + l.rayT2 * 4.f * dt * dt), l.depthRate);
         float mox = l.rayMx * st, moy = l.rayMy * st;
         float cRay = l.rayC + l.rayC2 * ray.u2[j];
+        if (followMotion) {
+            const Vec2f shift = motionShift(l, ray.px[j] + cRay * ray.ux[j], ray.py[j] - cRay * ray.uy[j], l.motionScale * st, {mox, moy});
+            mox = shift.x, moy = shift.y;
+        }
         if (kFollow || followMotion) {
             // One fixed-point step: the slope and the motion of the surface found at the
             // layer's shear.
@@ -1066,6 +1229,7 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
         Split split;
         std::vector<SlopeMoments> moments;  // per motion group and cell (slopeRate)
         std::vector<SlopeMoments> depthMoments;  // ... of the depth (depthRateOf)
+        FieldScratch field;                      // groupByMotionField
         std::vector<float> binKey;          // per layer and kOrderBins bin: its nearest sample
         std::vector<int> binOrder, binRank;  // per bin: the layers front to back, each layer's place
         std::vector<uint8_t> before;        // per order bin and pair of layers: the first goes before the second
@@ -1115,30 +1279,12 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                 Gathered* next = g.data();
                 // The slopes of each class, kept in registers while the samples are read (as
                 // range[cls].add(c) they went through memory, a store and a load per sample on
-                // the gather's critical path), and the motion groups' first motions and squared
-                // tolerances.
+                // the gather's critical path). A moving sample's class is 1 until the tile's
+                // motion groups are known (groupByMotionField).
                 float lo[kClasses], hi[kClasses];
                 std::fill(lo, lo + kClasses, kInf);
                 std::fill(hi, hi + kClasses, -kInf);
-                Vec2f group[kMotionGroups];
-                float groupTol2[kMotionGroups];
-                int groups = 0;
-                // The motion group of a moving sample (kMotionGroups).
-                auto groupOf = [&](float mx, float my) {
-                    int nearest = 0;
-                    float best = kInf;
-                    for (int k = 0; k < groups; ++k) {
-                        const float d2 = sqr(mx - group[k].x) + sqr(my - group[k].y);
-                        if (d2 <= groupTol2[k]) return k;
-                        if (d2 < best) best = d2, nearest = k;
-                    }
-                    if (groups < kMotionGroups) {
-                        group[groups] = {mx, my};
-                        groupTol2[groups] = sqr(std::max(kMotionTolerance, kMotionToleranceRel * std::sqrt(mx * mx + my * my)));
-                        return groups++;
-                    }
-                    return nearest;
-                };
+                bool anyMoving = false;
                 for (int y = ry0; y < ry1; ++y)
                     for (int x = rx0; x < rx1; ++x) {
                         const size_t q = size_t(y) * W + x;
@@ -1152,7 +1298,8 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                             a.t = s.time();
                             a.mx = m.x;
                             a.my = m.y;
-                            a.cls = uint8_t(movesOnScreen(m) ? 1 + groupOf(m.x, m.y) : 0);
+                            a.cls = uint8_t(movesOnScreen(m) ? 1 : 0);
+                            anyMoving |= a.cls != 0;
                             a.c = slopeOf(s, view);
                             a.invDepth = s.hit() ? 1.f / std::max(s.depth, 1e-6f) : 0.f;
                             a.albedo = s.albedo;
@@ -1167,6 +1314,7 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                     }
                 assert(next == g.data() + g.size());  // every sample counted was read
                 gatheredTotal += g.size();
+                const int groups = anyMoving ? groupByMotionField(g, rx0, ry0, rx1, ry1, local.field, lo, hi) : 0;
                 SlopeRange range[kClasses];
                 for (int k = 0; k < kClasses; ++k) range[k] = {lo[k], hi[k]};
                 // Under a pinhole, with motion in the tile, the still samples are split by their
@@ -1593,6 +1741,9 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                         if (motionAcc[k].empty()) continue;
                         Layer& l = layers[k];
                         const AffineMotion fit = fitMotion(motionAcc[k], l.gw, l.gh, Vec2f{l.mx, l.my});
+                        l.affMx = fit.mean.x, l.affMy = fit.mean.y;
+                        l.affCx = fit.centre.x + float(l.gx0), l.affCy = fit.centre.y + float(l.gy0);
+                        l.affB00 = fit.b00, l.affB01 = fit.b01, l.affB10 = fit.b10, l.affB11 = fit.b11;
                         smooth(motionAcc[k], l.gw, l.gh, 3, l.sigma);
                         l.motionGrid.resize(size_t(l.gw) * l.gh * 2);
                         const size_t cells = size_t(l.gw) * l.gh;
@@ -1626,7 +1777,10 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                             if (motionAcc[k].empty() || (reorder && !inFront(k, sl, s.t))) continue;
                             Layer& l = layers[k];
                             if (l.inFrontOfAll(s.invDepth, s.t)) continue;
-                            const Vec2f m = motionAt(l, bilinear(l, l.sharpPosition(s)));
+                            const float dt = alongChord(s.t - 0.5f, l.depthRate);
+                            const Vec2f q{s.x + l.c * s.u, s.y - l.c * s.v};
+                            const Vec2f shift = motionShift(l, q.x, q.y, dt, Vec2f{l.mx * dt, l.my * dt});
+                            const Vec2f m = motionAt(l, bilinear(l, {q.x - shift.x, q.y - shift.y}));
                             const int ci = l.cellIndex(l.sharpPosition(s, m.x, m.y));
                             if (ci >= 0) l.accD[ci] += 1.f;
                         }
