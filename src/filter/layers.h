@@ -19,7 +19,8 @@
 // Per screen tile (64 pixels, with an apron as wide as the trajectories that reach it, at most
 // LayerOptions::maxReach):
 // 1. The samples are split into depth layers: still samples and up to sixteen groups of moving
-//    ones of like motion apart (layers.cpp, kMotionGroups), each sorted by defocus slope (which
+//    ones apart, a group per connected part of the motion field (layers.cpp, groupByMotionField,
+//    kMotionGroups), each sorted by defocus slope (which
 //    falls with depth; a moving group whose slope changes over the shutter, an object moving in
 //    depth, by its slope at mid-shutter: layers.cpp, slopeRate); a new layer starts where the slopes spread more than
 //    max(0.5, 0.15 |c|) pixels or jump by half a pixel; consecutive still layers that are each
