@@ -198,6 +198,29 @@ inline Vec2f layerPosition(const Gathered& s, bool sharp, float c, float mx, flo
 /// The time bin of shutter time t among `bins`.
 inline int timeBinOf(int bins, float t) { return std::min(bins - 1, int(t * float(bins))); }
 
+/// The least-squares affine fit m(p) = mean + B (p - centre) of a moving layer's samples' screen
+/// motion to their positions in its sharp image. An object moving in depth grows or shrinks on
+/// screen over the shutter, so its samples' motion spreads radially, about linearly in their
+/// position: a ray at the shutter's open past the rim of its mid-shutter image, where the grid
+/// has no samples, takes the motion the rim would have there and finds the rim (with the
+/// layer's mean motion it missed it: a sphere moving 1 unit away from a depth of 3.7, the
+/// trail's start too bright, docs/layers.md, "Objects moving in depth: the rate along the chord").
+struct AffineMotion {
+    Vec2f mean, centre;
+    float b00 = 0, b01 = 0, b10 = 0, b11 = 0;
+    /// The fit at p, its offset from the mean at most `limit` long.
+    Vec2f at(Vec2f p, float limit) const {
+        const float dx = p.x - centre.x, dy = p.y - centre.y;
+        float ox = b00 * dx + b01 * dy, oy = b10 * dx + b11 * dy;
+        const float len2 = ox * ox + oy * oy;
+        if (len2 > limit * limit) {
+            const float k = limit / std::sqrt(len2);
+            ox *= k, oy *= k;
+        }
+        return {mean.x + ox, mean.y + oy};
+    }
+};
+
 struct Layer {
     double sumC = 0, sumMx = 0, sumMy = 0, sumInvDepth = 0;
     float cMin = kInf, cMax = -kInf;
@@ -228,9 +251,9 @@ struct Layer {
     // stretched its blur (layers.cpp, the splat).
     float motionScale = 1, maxMotion = 0;
     std::vector<float> motionGrid;
-    // The affine fit of its samples' motion to their sharp position (film pixels), m(p) = aff +
-    // affB (p - affC): where a ray or a sample behind starts on the layer (motionShift).
-    float affMx = 0, affMy = 0, affCx = 0, affCy = 0, affB00 = 0, affB01 = 0, affB10 = 0, affB11 = 0;
+    // The affine fit of its samples' motion to their sharp position, its centre in film pixels:
+    // where a ray or a sample behind starts on the layer (motionShift).
+    AffineMotion motionFit;
     static constexpr int kShearSteps = 8;
     float shearFrom = 0, shearScale = 0;  // the table's index: (c - shearFrom) shearScale
     Shaped shearTable[kShearSteps + 1];
@@ -939,28 +962,6 @@ struct Bilinear {
     const int c00 = j0 * l.gw + i0;
     return {{c00, c00 + 1, c00 + l.gw, c00 + l.gw + 1}, {(1 - ax) * (1 - ay), ax * (1 - ay), (1 - ax) * ay, ax * ay}};
 }
-/// The least-squares affine fit m(p) = mean + B (p - centre) of a moving layer's samples' screen
-/// motion to their positions in its sharp image. An object moving in depth grows or shrinks on
-/// screen over the shutter, so its samples' motion spreads radially, about linearly in their
-/// position: a ray at the shutter's open past the rim of its mid-shutter image, where the grid
-/// has no samples, takes the motion the rim would have there and finds the rim (with the
-/// layer's mean motion it missed it: a sphere moving 1 unit away from a depth of 3.7, the
-/// trail's start too bright, docs/layers.md, "Objects moving in depth: the rate along the chord").
-struct AffineMotion {
-    Vec2f mean, centre;
-    float b00 = 0, b01 = 0, b10 = 0, b11 = 0;
-    /// The fit at p, its offset from the mean at most `limit` long.
-    Vec2f at(Vec2f p, float limit) const {
-        const float dx = p.x - centre.x, dy = p.y - centre.y;
-        float ox = b00 * dx + b01 * dy, oy = b10 * dx + b11 * dy;
-        const float len2 = ox * ox + oy * oy;
-        if (len2 > limit * limit) {
-            const float k = limit / std::sqrt(len2);
-            ox *= k, oy *= k;
-        }
-        return {mean.x + ox, mean.y + oy};
-    }
-};
 /// The AffineMotion of a motion grid's unsmoothed sums (per cell: count, sum of mx, sum of my;
 /// gw x gh cells of 1 pixel), the fit's positions at the cells' centres; `fallback` (with no
 /// gradient) where the samples do not span two dimensions.
@@ -1048,14 +1049,6 @@ struct Rays {
     return covers && alpha < 1.f - 1e-4f ? 1 : 0;
 }
 
-/// Rays [j0, j1) through a blurred layer (the `index`-th a pixel's rays see): the layer's lens
-/// and shutter shear, then (kFollow) the slope of the surface found there, shaped by the grid's
-/// blur, and the layer's alpha and premultiplied light there (kMoving: between its two nearest
-/// time bins) composited under what is in front, C += T alpha L, T *= 1 - alpha, for the rays
-/// not yet stopped (T >= 1e-4). Per ray the arithmetic of the scalar loop it replaced, in the
-/// same order, as one SIMD loop (its images the same to float rounding, docs/layers.md): every
-/// lane is computed, and a stopped ray's results are not stored. Returns whether a ray took
-/// part of the layer's coverage.
 /// Where a ray (or a sample behind the layer, for D) meets a layer with a motion grid: the
 /// point p of its sharp image with q = p + s m(p), q the ray's point sheared by the lens alone
 /// and s its shutter offset along the chord (alongChord, times motionScale for a ray). Solved
@@ -1067,13 +1060,23 @@ struct Rays {
 /// docs/many-motion.json, the same as three fixed-point steps from the mean motion at a third
 /// of their cost (docs/layers.md, "A held-out bunny moving through slats").
 [[gnu::always_inline]] inline Vec2f motionShift(const Layer& l, float qx, float qy, float s, Vec2f fallback) {
-    const float a00 = 1.f + s * l.affB00, a01 = s * l.affB01, a10 = s * l.affB10, a11 = 1.f + s * l.affB11;
-    const float rx = qx - s * (l.affMx - (l.affB00 * l.affCx + l.affB01 * l.affCy));
-    const float ry = qy - s * (l.affMy - (l.affB10 * l.affCx + l.affB11 * l.affCy));
+    const AffineMotion& f = l.motionFit;
+    const float a00 = 1.f + s * f.b00, a01 = s * f.b01, a10 = s * f.b10, a11 = 1.f + s * f.b11;
+    const float rx = qx - s * (f.mean.x - (f.b00 * f.centre.x + f.b01 * f.centre.y));
+    const float ry = qy - s * (f.mean.y - (f.b10 * f.centre.x + f.b11 * f.centre.y));
     const float det = a00 * a11 - a01 * a10;
     const bool solvable = det > 0.2f;  // (a fit that folds the layer over itself within the shutter: the mean motion's shift)
     return {solvable ? qx - (a11 * rx - a01 * ry) / det : fallback.x, solvable ? qy - (a00 * ry - a10 * rx) / det : fallback.y};
 }
+
+/// Rays [j0, j1) through a blurred layer (the `index`-th a pixel's rays see): the layer's lens
+/// and shutter shear, then (kFollow) the slope of the surface found there, shaped by the grid's
+/// blur, and the layer's alpha and premultiplied light there (kMoving: between its two nearest
+/// time bins) composited under what is in front, C += T alpha L, T *= 1 - alpha, for the rays
+/// not yet stopped (T >= 1e-4). Per ray the arithmetic of the scalar loop it replaced, in the
+/// same order, as one SIMD loop (its images the same to float rounding, docs/layers.md): every
+/// lane is computed, and a stopped ray's results are not stored. Returns whether a ray took
+/// part of the layer's coverage.
 template <bool kFollow, bool kMoving>
 bool traceBlurred(const Layer& l, int index, Rays& ray, int j0, int j1) {
     const int cs = l.cellStride(), bins = l.timeBins;
@@ -1741,9 +1744,8 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                         if (motionAcc[k].empty()) continue;
                         Layer& l = layers[k];
                         const AffineMotion fit = fitMotion(motionAcc[k], l.gw, l.gh, Vec2f{l.mx, l.my});
-                        l.affMx = fit.mean.x, l.affMy = fit.mean.y;
-                        l.affCx = fit.centre.x + float(l.gx0), l.affCy = fit.centre.y + float(l.gy0);
-                        l.affB00 = fit.b00, l.affB01 = fit.b01, l.affB10 = fit.b10, l.affB11 = fit.b11;
+                        l.motionFit = fit;
+                        l.motionFit.centre = {fit.centre.x + float(l.gx0), fit.centre.y + float(l.gy0)};
                         smooth(motionAcc[k], l.gw, l.gh, 3, l.sigma);
                         l.motionGrid.resize(size_t(l.gw) * l.gh * 2);
                         const size_t cells = size_t(l.gw) * l.gh;
