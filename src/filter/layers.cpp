@@ -170,7 +170,8 @@ inline int gridCell(int gx0, int gy0, int gw, int gh, Vec2f p) {
 /// (Reprojected along the chord at a constant rate, a sphere moving 1 unit away from a depth of
 /// 3.7 over the shutter, its chord 100 px, put its mid-shutter samples 6 px from its others in
 /// its sharp image: docs/layers.md, "Objects moving in depth: the rate along the chord".)
-[[gnu::always_inline]] inline float alongChord(float s, float g) { return (1.f - 0.25f * g * g) * s / (1.f + g * s); }
+/// (s itself where g = 0, without the division: the same value, and most layers are still.)
+[[gnu::always_inline]] inline float alongChord(float s, float g) { return g == 0.f ? s : (1.f - 0.25f * g * g) * s / (1.f + g * s); }
 /// Whether a sample of inverse depth q at shutter time t lies clearly (kOrderMargin) in front of
 /// every point of a moving layer whose nearest sample has inverse depth invDepthMax and whose
 /// depth changes at the rate g. Its nearest point's inverse depth at t is that sample's taken at
@@ -1145,10 +1146,11 @@ bool traceBlurred(const Layer& l, int index, Rays& ray, int j0, int j1) {
 }
 
 /// Samples behind a layer with a motion grid, for its D (the D pass of reconstructLayers): each
-/// one's point q sheared by the layer's lens slope, and its shutter offset dt along the chord.
+/// one's point q sheared by the layer's lens slope, and its shutter time t (motionCells takes its
+/// offset along the chord, alongChord).
 struct MotionBatch {
     static constexpr int kMax = 256;
-    alignas(64) float qx[kMax], qy[kMax], dt[kMax];
+    alignas(64) float qx[kMax], qy[kMax], t[kMax];
     alignas(64) int cell[kMax];
     int n = 0;
 };
@@ -1163,7 +1165,7 @@ void motionCells(const Layer& l, const int* occupied, int margin, MotionBatch& b
     const int gw = l.gw, gh = l.gh, ow = gw + 1, n = b.n;
 #pragma omp simd
     for (int j = 0; j < n; ++j) {
-        const float qx = b.qx[j], qy = b.qy[j], dt = b.dt[j];
+        const float qx = b.qx[j], qy = b.qy[j], dt = alongChord(b.t[j] - 0.5f, l.depthRate);
         const float r = std::abs(dt) * l.maxMotion + 1.f;
         const int i0 = int(std::floor(qx - r)) - l.gx0 - margin, i1 = int(std::floor(qx + r)) - l.gx0 + margin;
         const int j0 = int(std::floor(qy - r)) - l.gy0 - margin, j1 = int(std::floor(qy + r)) - l.gy0 + margin;
@@ -1475,10 +1477,6 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                 splitLayers(g, keyRange, rate, depthRate, splitRange, o, split, key);
                 std::vector<Layer>& layers = split.layers;
                 layerTotal += layers.size();
-                // Each sample's layer, looked up once for the passes below.
-                std::vector<uint16_t>& sampleLayer = local.sampleLayer;
-                sampleLayer.resize(g.size());
-                for (size_t i = 0; i < g.size(); ++i) sampleLayer[i] = uint16_t(split.layerOf(g[i]));
                 // Front to back at each time: where a moving layer passes in depth behind or in
                 // front of another layer over the shutter, the two are ordered in each of
                 // kOrderBins bins of shutter time (the rule per pair below); every other pair
@@ -1531,11 +1529,11 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                         const Gathered& a = g[i];
                         if (a.cls == 0) {
                             if (i % kOrderStride) continue;
-                            Vec2f& d = depthCells[size_t(sampleLayer[i]) * cells + cellOf(a.x, a.y)];
+                            Vec2f& d = depthCells[size_t(split.layerOf(a)) * cells + cellOf(a.x, a.y)];
                             d.x += a.invDepth, d.y += 1.f;
                             continue;
                         }
-                        const int k = sampleLayer[i];
+                        const int k = split.layerOf(a);
                         const size_t kb = size_t(k) * kOrderBins + size_t(timeBinOf(kOrderBins, a.t));
                         binKey[kb] = std::max(binKey[kb], a.invDepth);
                         std::array<float, 4>& bx = box[kb];
@@ -1738,18 +1736,21 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                 };
                 if (in.textured && in.surfaceAlbedo[0]) {
                     surfaceLayer.assign(size_t(tw) * th * kSurfaces, -1);
-                    for (size_t i = 0; i < g.size(); ++i) {
-                        const Gathered& s = g[i];
+                    for (const Gathered& s : g) {
                         const int tp = s.surface >= 0 ? tilePixel(s) : -1;
                         if (tp < 0 || !((*in.textured)[s.pixel] & kTextureSurface)) continue;
                         int16_t& k = surfaceLayer[size_t(tp) * kSurfaces + size_t(s.surface)];
-                        const int sl = sampleLayer[i];
+                        const int sl = split.layerOf(s);
                         k = k == -1 ? int16_t(sl) : k == sl ? k : int16_t(-2);
                     }
                 }
+                // (Each sample's layer kept for the D pass of the layers with a motion grid.)
+                std::vector<uint16_t>& sampleLayer = local.sampleLayer;
+                sampleLayer.resize(g.size());
                 for (size_t i = 0; i < g.size(); ++i) {
                     const Gathered& s = g[i];
-                    const int sl = sampleLayer[i];
+                    const int sl = split.layerOf(s);
+                    sampleLayer[i] = uint16_t(sl);
                     // D of the layers in front, at their shear (as Layer::sharpPosition): where this
                     // sample shows that they do not cover. Not that of a moving layer it lies in
                     // front of then (a still post a moving object passes behind, in a tile that
@@ -1884,7 +1885,7 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                             MotionBatch& b = batch[size_t(k)];
                             b.qx[b.n] = s.x + l.c * s.u;
                             b.qy[b.n] = s.y - l.c * s.v;
-                            b.dt[b.n] = alongChord(s.t - 0.5f, l.depthRate);
+                            b.t[b.n] = s.t;
                             if (++b.n == MotionBatch::kMax) flush(k);
                         }
                     }
