@@ -804,8 +804,8 @@ void splitLayers(Samples& g, const SlopeRange (&range)[kClasses], const float (&
 
 /// Separable Gaussian of `sigma` cells over channels [c0, c1) of the `stride` interleaved
 /// channels of `acc` (gw x gh); c1 < 0: to the last. kChannels > 0: c1 - c0 known at compile
-/// time (the common runs: the loops over channels unrolled and vectorised; the same sums in the
-/// same order, so the same bytes as the general loop).
+/// time (the common runs, a still layer's and a moving one's: the loops over channels unrolled
+/// and vectorised; the same sums in the same order, so the same bytes as the general loop).
 template <int kChannels>
 void smoothRun(std::vector<float>& acc, int gw, int gh, int stride, float sigma, int c0, int c1) {
     const int n = kChannels > 0 ? kChannels : c1 - c0;
@@ -841,6 +841,8 @@ void smooth(std::vector<float>& acc, int gw, int gh, int stride, float sigma, in
         case 3: return smoothRun<3>(acc, gw, gh, stride, sigma, c0, c1);
         case 4: return smoothRun<4>(acc, gw, gh, stride, sigma, c0, c1);
         case 6: return smoothRun<6>(acc, gw, gh, stride, sigma, c0, c1);
+        case 4 * kTimeBins: return smoothRun<4 * kTimeBins>(acc, gw, gh, stride, sigma, c0, c1);  // a moving layer's W, R, G, B per time bin
+        case 2 + 4 * kTimeBins: return smoothRun<2 + 4 * kTimeBins>(acc, gw, gh, stride, sigma, c0, c1);  // ... with N and the slopes
         default: return smoothRun<0>(acc, gw, gh, stride, sigma, c0, c1);
     }
 }
@@ -1064,8 +1066,9 @@ struct Rays {
 /// layer): AAF relMSE with the affine start -26% on docs/sphere-away.json, -8% on
 /// docs/many-motion.json, the same as three fixed-point steps from the mean motion at a third
 /// of their cost (docs/layers.md, "A held-out bunny moving through slats").
-[[gnu::always_inline]] inline Vec2f motionShift(const Layer& l, float qx, float qy, float s, Vec2f fallback) {
-    const AffineMotion& f = l.motionFit;
+/// (`f` is the layer's motionFit, copied by the caller out of its SIMD loop: read through the
+/// layer under the loop's condition, its loads kept the moving rays' loop from vectorising.)
+[[gnu::always_inline]] inline Vec2f motionShift(const AffineMotion& f, float qx, float qy, float s, Vec2f fallback) {
     const float a00 = 1.f + s * f.b00, a01 = s * f.b01, a10 = s * f.b10, a11 = 1.f + s * f.b11;
     const float rx = qx - s * (f.mean.x - (f.b00 * f.centre.x + f.b01 * f.centre.y));
     const float ry = qy - s * (f.mean.y - (f.b10 * f.centre.x + f.b11 * f.centre.y));
@@ -1087,6 +1090,7 @@ bool traceBlurred(const Layer& l, int index, Rays& ray, int j0, int j1) {
     const int cs = l.cellStride(), bins = l.timeBins;
     const float* cell = l.cell.data();
     const bool followMotion = kMoving && !l.motionGrid.empty();
+    const AffineMotion fit = l.motionFit;
     int partial = 0;
 #pragma omp simd reduction(| : partial)
     for (int j = j0; j < j1; ++j) {
@@ -1095,7 +1099,7 @@ bool traceBlurred(const Layer& l, int index, Rays& ray, int j0, int j1) {
         float mox = l.rayMx * st, moy = l.rayMy * st;
         float cRay = l.rayC + l.rayC2 * ray.u2[j];
         if (followMotion) {
-            const Vec2f shift = motionShift(l, ray.px[j] + cRay * ray.ux[j], ray.py[j] - cRay * ray.uy[j], l.motionScale * st, {mox, moy});
+            const Vec2f shift = motionShift(fit, ray.px[j] + cRay * ray.ux[j], ray.py[j] - cRay * ray.uy[j], l.motionScale * st, {mox, moy});
             mox = shift.x, moy = shift.y;
         }
         if (kFollow || followMotion) {
@@ -1163,6 +1167,7 @@ struct MotionBatch {
 /// spare for rounding.
 void motionCells(const Layer& l, const int* occupied, int margin, MotionBatch& b) {
     const int gw = l.gw, gh = l.gh, ow = gw + 1, n = b.n;
+    const AffineMotion fit = l.motionFit;
 #pragma omp simd
     for (int j = 0; j < n; ++j) {
         const float qx = b.qx[j], qy = b.qy[j], dt = alongChord(b.t[j] - 0.5f, l.depthRate);
@@ -1173,7 +1178,7 @@ void motionCells(const Layer& l, const int* occupied, int margin, MotionBatch& b
         const int a0 = minValue(gw, maxValue(0, i0)), a1 = minValue(gw, maxValue(0, i1 + 1));
         const int c0 = minValue(gh, maxValue(0, j0)), c1 = minValue(gh, maxValue(0, j1 + 1));
         const int samples = occupied[c1 * ow + a1] - occupied[c1 * ow + a0] - occupied[c0 * ow + a1] + occupied[c0 * ow + a0];
-        const Vec2f shift = motionShift(l, qx, qy, dt, Vec2f{l.mx * dt, l.my * dt});
+        const Vec2f shift = motionShift(fit, qx, qy, dt, Vec2f{l.mx * dt, l.my * dt});
         const Vec2f m = motionAt(l, bilinear(l, {qx - shift.x, qy - shift.y}));
         // (gridCell's cell, with its tests as one mask for the SIMD loop.)
         const int ci = int(std::floor(qx - m.x * dt)) - l.gx0, cj = int(std::floor(qy - m.y * dt)) - l.gy0;
