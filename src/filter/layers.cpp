@@ -1289,6 +1289,7 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
         // The D pass of the layers with a motion grid (withGrid): per layer, its cells with
         // samples summed over rectangles, its margin, and the samples behind it, a batch at a time.
         std::vector<int> withGrid, margin;
+        std::vector<std::array<float, 4>> reachBox;
         std::vector<std::vector<int>> occupied;
         std::vector<MotionBatch> batch;
         std::vector<uint16_t> sampleLayer;  // per gathered sample: its layer (Split::layerOf)
@@ -1853,19 +1854,32 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                     if (batch.size() < size_t(nLayers)) batch.resize(size_t(nLayers));
                     std::vector<int>& margin = local.margin;
                     margin.assign(size_t(nLayers), 0);
+                    // Per layer, the points q that can count (motionCells): within the margin
+                    // and the largest motion's reach of the box of its cells with samples.
+                    std::vector<std::array<float, 4>>& reachBox = local.reachBox;
+                    reachBox.assign(size_t(nLayers), {kInf, kInf, -kInf, -kInf});
                     for (const int k : withGrid) {
                         const Layer& l = layers[size_t(k)];
                         const int gw = l.gw, gh = l.gh, as = l.accStride();
                         std::vector<int>& o = occupied[size_t(k)];
                         o.assign(size_t(gw + 1) * (gh + 1), 0);
+                        int bx0 = gw, by0 = gh, bx1 = -1, by1 = -1;
                         for (int j = 0; j < gh; ++j) {
                             int row = 0;
                             for (int i = 0; i < gw; ++i) {
-                                row += l.acc[(size_t(j) * gw + i) * as] > 0.f ? 1 : 0;
+                                const bool has = l.acc[(size_t(j) * gw + i) * as] > 0.f;
+                                row += has ? 1 : 0;
                                 o[size_t(j + 1) * (gw + 1) + i + 1] = o[size_t(j) * (gw + 1) + i + 1] + row;
+                                if (has) bx0 = std::min(bx0, i), bx1 = std::max(bx1, i), by0 = std::min(by0, j), by1 = std::max(by1, j);
                             }
                         }
-                        margin[size_t(k)] = 2 * int(std::ceil(3.f * l.sigmaCoverage)) + 2 * kFillRings + 2;
+                        const int m = 2 * int(std::ceil(3.f * l.sigmaCoverage)) + 2 * kFillRings + 2;
+                        margin[size_t(k)] = m;
+                        // (motionCells' r is at most |dt| maxMotion + 1, |dt| at most chordReach; a cell to spare.)
+                        const float reach = float(m) + chordReach(l.depthRate) * l.maxMotion + 2.f;
+                        if (bx1 >= 0)
+                            reachBox[size_t(k)] = {float(l.gx0 + bx0) - reach, float(l.gy0 + by0) - reach, float(l.gx0 + bx1 + 1) + reach,
+                                                   float(l.gy0 + by1 + 1) + reach};
                         batch[size_t(k)].n = 0;
                     }
                     auto flush = [&](int k) {
@@ -1886,10 +1900,13 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                             if (!reorder && k >= sl) break;
                             if (reorder && !inFront(k, sl, s.t)) continue;
                             const Layer& l = layers[size_t(k)];
+                            const float qx = s.x + l.c * s.u, qy = s.y - l.c * s.v;
+                            const std::array<float, 4>& box = reachBox[size_t(k)];
+                            if (qx < box[0] || qy < box[1] || qx >= box[2] || qy >= box[3]) continue;
                             if (l.inFrontOfAll(s.invDepth, s.t)) continue;
                             MotionBatch& b = batch[size_t(k)];
-                            b.qx[b.n] = s.x + l.c * s.u;
-                            b.qy[b.n] = s.y - l.c * s.v;
+                            b.qx[b.n] = qx;
+                            b.qy[b.n] = qy;
                             b.t[b.n] = s.t;
                             if (++b.n == MotionBatch::kMax) flush(k);
                         }
