@@ -893,15 +893,26 @@ void resolveCells(Layer& l, float minWeight) {
     std::vector<int> holes;
     for (int i = 0; i < cells; ++i)
         if (!alphaOk[i] || (!radianceOk[i] && l.cell[size_t(i) * cs] > 0.f)) holes.push_back(i);
+    // Per ring, the holes that have a valid neighbour and the means they take. Most holes of a
+    // layer's grid have none (far from its samples, where nothing behind them counted in D), and
+    // a hole can gain one only next to a cell filled in the ring before: after the first ring
+    // only those holes are looked at (the same fills as looking at every hole every ring).
+    struct Fill {
+        int cell;
+        bool alpha, radiance;
+    };
+    auto isHole = [&](int i) { return !alphaOk[i] || (!radianceOk[i] && l.cell[size_t(i) * cs] > 0.f); };
+    std::vector<Fill> fills;
     std::vector<float> values;
-    std::vector<uint8_t> gotAlpha, gotRadiance;
+    std::vector<int> next;
+    std::vector<int8_t> seen(holes.empty() ? 0 : size_t(cells), -1);  // the ring a hole was last put in `next`
+    float v[2 + 3 * kTimeBins];
     for (int ring = 0; ring < kRings && !holes.empty(); ++ring) {
-        values.assign(holes.size() * cs, 0.f);
-        gotAlpha.assign(holes.size(), 0);
-        gotRadiance.assign(holes.size(), 0);
-        for (size_t h = 0; h < holes.size(); ++h) {
-            const int i = holes[h], x = i % l.gw, y = i / l.gw;
-            float* v = &values[h * cs];
+        fills.clear();
+        values.clear();
+        for (const int i : holes) {
+            const int x = i % l.gw, y = i / l.gw;
+            std::fill_n(v, cs, 0.f);
             int nA = 0, nL = 0;
             for (int dy = -1; dy <= 1; ++dy)
                 for (int dx = -1; dx <= 1; ++dx) {
@@ -915,24 +926,39 @@ void resolveCells(Layer& l, float minWeight) {
                         ++nL;
                     }
                 }
-            if (nA > 0) v[0] /= float(nA), gotAlpha[h] = 1;
-            if (nL > 0) {
+            if (nA == 0 && nL == 0) continue;
+            if (nA > 0) v[0] /= float(nA);
+            if (nL > 0)
                 for (int k = 1; k < cs; ++k) v[k] /= float(nL);
-                gotRadiance[h] = 1;
-            }
+            fills.push_back({i, nA > 0, nL > 0});
+            values.insert(values.end(), v, v + cs);
         }
-        std::vector<int> still;
-        for (size_t h = 0; h < holes.size(); ++h) {
-            const int i = holes[h];
+        for (size_t f = 0; f < fills.size(); ++f) {
+            const int i = fills[f].cell;
             float* c = &l.cell[size_t(i) * cs];
-            if (gotAlpha[h]) c[0] = values[h * cs], alphaOk[i] = 1;
-            if (gotRadiance[h]) {
-                for (int k = 1; k < cs; ++k) c[k] = values[h * cs + k];
+            const float* value = &values[f * cs];
+            if (fills[f].alpha) c[0] = value[0], alphaOk[i] = 1;
+            if (fills[f].radiance) {
+                for (int k = 1; k < cs; ++k) c[k] = value[k];
                 radianceOk[i] = 1;
             }
-            if (!alphaOk[i] || (!radianceOk[i] && c[0] > 0.f)) still.push_back(i);
         }
-        holes.swap(still);
+        // The holes next to a cell filled in this ring, in the order of the cells.
+        next.clear();
+        for (const Fill& f : fills) {
+            const int x = f.cell % l.gw, y = f.cell / l.gw;
+            for (int dy = -1; dy <= 1; ++dy)
+                for (int dx = -1; dx <= 1; ++dx) {
+                    const int xx = x + dx, yy = y + dy;
+                    if (xx < 0 || yy < 0 || xx >= l.gw || yy >= l.gh) continue;
+                    const int q = yy * l.gw + xx;
+                    if (seen[size_t(q)] == ring || !isHole(q)) continue;
+                    seen[size_t(q)] = int8_t(ring);
+                    next.push_back(q);
+                }
+        }
+        std::sort(next.begin(), next.end());
+        holes.swap(next);
     }
     // Premultiply; what is still without radiance is taken as uncovered.
     for (int i = 0; i < cells; ++i) {
