@@ -1967,7 +1967,7 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                 std::vector<int> binActive;  // (timeOrder) per order bin, `active` in its order
                 Rays ray, sorted;
                 // The rays' sequence before each pixel's shift: (j + 1) k_d modulo 1.
-                float kron[Rays::kMax][5];
+                alignas(64) float kron[5][Rays::kMax];  // (by dimension: the rays' SIMD loop below reads them as vectors)
                 const int rays = anyBlurred ? std::clamp(o.rays, 1, Rays::kMax) : 1;
                 // Where a layer moves, the rays that straddle integrate over the shutter as well,
                 // and their own noise is a larger part of the error: movingRays there
@@ -1979,7 +1979,7 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                 for (int j = 0; j < mixedRays; ++j)
                     for (int d = 0; d < 5; ++d) {
                         const double v = double(j + 1) * kKronecker[d];
-                        kron[j][d] = float(v - std::floor(v));
+                        kron[d][j] = float(v - std::floor(v));
                     }
 
                 // Reconstruction rays, composited front to back.
@@ -2087,22 +2087,36 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                             }
                         };
                         auto trace = [&](int j0, int j1) {
-                            for (int j = j0; j < j1; ++j) {
-                                float q[5];
-                                for (int d = 0; d < 5; ++d) {
-                                    const float v = shift[d] + kron[j][d];
-                                    q[d] = v >= 1.f ? v - 1.f : v;
+                            // (Locals, not the lambda's references, and one loop for each value of
+                            // anyBlurred, so that the loop vectorises.)
+                            const float fx = float(x), fy = float(y);
+                            const float s0 = shift[0], s1 = shift[1], s2 = shift[2], s3 = shift[3], s4 = shift[4];
+                            Rays& r = ray;
+                            auto wrap = [](float v) { return v >= 1.f ? v - 1.f : v; };
+                            if (anyBlurred) {
+#pragma omp simd
+                                for (int j = j0; j < j1; ++j) {
+                                    const Vec2f u = concentricDisc(wrap(s2 + kron[2][j]), wrap(s3 + kron[3][j]));
+                                    r.ux[j] = u.x;
+                                    r.uy[j] = u.y;
+                                    r.u2[j] = u.x * u.x + u.y * u.y;
+                                    r.px[j] = fx + wrap(s0 + kron[0][j]);
+                                    r.py[j] = fy + wrap(s1 + kron[1][j]);
+                                    r.dt[j] = wrap(s4 + kron[4][j]) - 0.5f;
+                                    r.cr[j] = r.cg[j] = r.cb[j] = 0.f;
+                                    r.trans[j] = 1.f;
+                                    r.hit[j] = -1;
                                 }
-                                const Vec2f u = anyBlurred ? concentricDisc(q[2], q[3]) : Vec2f{0, 0};
-                                ray.ux[j] = u.x;
-                                ray.uy[j] = u.y;
-                                ray.u2[j] = u.x * u.x + u.y * u.y;
-                                ray.px[j] = float(x) + (anyBlurred ? q[0] : 0.5f);
-                                ray.py[j] = float(y) + (anyBlurred ? q[1] : 0.5f);
-                                ray.dt[j] = (anyBlurred ? q[4] : 0.5f) - 0.5f;
-                                ray.cr[j] = ray.cg[j] = ray.cb[j] = 0.f;
-                                ray.trans[j] = 1.f;
-                                ray.hit[j] = -1;
+                            } else {
+                                for (int j = j0; j < j1; ++j) {
+                                    r.ux[j] = r.uy[j] = r.u2[j] = 0.f;
+                                    r.px[j] = fx + 0.5f;
+                                    r.py[j] = fy + 0.5f;
+                                    r.dt[j] = 0.f;
+                                    r.cr[j] = r.cg[j] = r.cb[j] = 0.f;
+                                    r.trans[j] = 1.f;
+                                    r.hit[j] = -1;
+                                }
                             }
                             if (reorderedActive < 2 || sameOrder) return traceLayers(j0, j1, reorderedActive >= 2 ? binActive.data() : nullptr);
                             // Where the order of the layers the pixel's rays see changes over the
