@@ -222,6 +222,20 @@ struct AffineMotion {
     }
 };
 
+/// The count of a gw x gh grid's cells where `has(i, j)`, summed over rectangles: sat[(j + 1)
+/// (gw + 1) + i + 1] counts the cells [0, i] x [0, j] ((gw + 1) x (gh + 1) entries).
+template <class Has>
+void summedArea(int gw, int gh, std::vector<int>& sat, Has&& has) {
+    sat.assign(size_t(gw + 1) * (gh + 1), 0);
+    for (int j = 0; j < gh; ++j) {
+        int row = 0;
+        for (int i = 0; i < gw; ++i) {
+            row += has(i, j) ? 1 : 0;
+            sat[size_t(j + 1) * (gw + 1) + i + 1] = sat[size_t(j) * (gw + 1) + i + 1] + row;
+        }
+    }
+}
+
 struct Layer {
     double sumC = 0, sumMx = 0, sumMy = 0, sumInvDepth = 0;
     float cMin = kInf, cMax = -kInf;
@@ -307,14 +321,7 @@ struct Layer {
 
     void buildCovered() {
         const int cs = cellStride();
-        covered.assign(size_t(gw + 1) * (gh + 1), 0);
-        for (int j = 0; j < gh; ++j) {
-            int row = 0;
-            for (int i = 0; i < gw; ++i) {
-                row += cell[(size_t(j) * gw + i) * cs] > 0.f ? 1 : 0;
-                covered[size_t(j + 1) * (gw + 1) + i + 1] = covered[size_t(j) * (gw + 1) + i + 1] + row;
-            }
-        }
+        summedArea(gw, gh, covered, [&](int i, int j) { return cell[(size_t(j) * gw + i) * cs] > 0.f; });
     }
     /// Whether any covered cell can be read by a lookup of pixel (x, y)'s rays: bilinear lookups
     /// within rayReach of the pixel's square, a sharp layer's at the pixel's own cell.
@@ -889,10 +896,10 @@ void resolveCells(Layer& l, float minWeight) {
     }
     // Ring-by-ring fill of what is missing where it can matter (alpha everywhere, radiance where
     // the cell has alpha).
-    constexpr int kRings = kFillRings;
+    auto isHole = [&](int i) { return !alphaOk[i] || (!radianceOk[i] && l.cell[size_t(i) * cs] > 0.f); };
     std::vector<int> holes;
     for (int i = 0; i < cells; ++i)
-        if (!alphaOk[i] || (!radianceOk[i] && l.cell[size_t(i) * cs] > 0.f)) holes.push_back(i);
+        if (isHole(i)) holes.push_back(i);
     // Per ring, the holes that have a valid neighbour and the means they take. Most holes of a
     // layer's grid have none (far from its samples, where nothing behind them counted in D), and
     // a hole can gain one only next to a cell filled in the ring before: after the first ring
@@ -901,13 +908,12 @@ void resolveCells(Layer& l, float minWeight) {
         int cell;
         bool alpha, radiance;
     };
-    auto isHole = [&](int i) { return !alphaOk[i] || (!radianceOk[i] && l.cell[size_t(i) * cs] > 0.f); };
     std::vector<Fill> fills;
     std::vector<float> values;
     std::vector<int> next;
     std::vector<int8_t> seen(holes.empty() ? 0 : size_t(cells), -1);  // the ring a hole was last put in `next`
     float v[2 + 3 * kTimeBins];
-    for (int ring = 0; ring < kRings && !holes.empty(); ++ring) {
+    for (int ring = 0; ring < kFillRings && !holes.empty(); ++ring) {
         fills.clear();
         values.clear();
         for (const int i : holes) {
@@ -1888,17 +1894,14 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                         const Layer& l = layers[size_t(k)];
                         const int gw = l.gw, gh = l.gh, as = l.accStride();
                         std::vector<int>& o = occupied[size_t(k)];
-                        o.assign(size_t(gw + 1) * (gh + 1), 0);
+                        summedArea(gw, gh, o, [&](int i, int j) { return l.acc[(size_t(j) * gw + i) * as] > 0.f; });
+                        // The box of those cells, from the sums' last row (per column) and last column (per row).
+                        const int* lastRow = &o[size_t(gh) * (gw + 1)];
                         int bx0 = gw, by0 = gh, bx1 = -1, by1 = -1;
-                        for (int j = 0; j < gh; ++j) {
-                            int row = 0;
-                            for (int i = 0; i < gw; ++i) {
-                                const bool has = l.acc[(size_t(j) * gw + i) * as] > 0.f;
-                                row += has ? 1 : 0;
-                                o[size_t(j + 1) * (gw + 1) + i + 1] = o[size_t(j) * (gw + 1) + i + 1] + row;
-                                if (has) bx0 = std::min(bx0, i), bx1 = std::max(bx1, i), by0 = std::min(by0, j), by1 = std::max(by1, j);
-                            }
-                        }
+                        for (int i = 0; i < gw; ++i)
+                            if (lastRow[i + 1] > lastRow[i]) bx0 = std::min(bx0, i), bx1 = i;
+                        for (int j = 0; j < gh; ++j)
+                            if (o[size_t(j + 1) * (gw + 1) + gw] > o[size_t(j) * (gw + 1) + gw]) by0 = std::min(by0, j), by1 = j;
                         const int m = 2 * int(std::ceil(3.f * l.sigmaCoverage)) + 2 * kFillRings + 2;
                         margin[size_t(k)] = m;
                         // (motionCells' r is at most |dt| maxMotion + 1, |dt| at most chordReach; a cell to spare.)
