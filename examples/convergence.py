@@ -30,7 +30,7 @@ def main():
     p.add_argument("--reference-spp", type=int, default=1024, help="MC reference samples per pixel (default 1024)")
     p.add_argument("--seed", type=int, default=1)
     p.add_argument("--layers", default="auto", choices=["auto", "on", "off"],
-                   help="the methods' --layers (default auto: on for mc and atrous); the reference is always off")
+                   help="the methods' --layers (default auto: on for mc and atrous, and for aaf and maaf where the scene moves); the reference is always off")
     p.add_argument("--repeat", type=int, default=1,
                    help="renders per point, the fastest counts (as wedge experiment --repeat; timings are noisy)")
     p.add_argument("--out", default="convergence.png", help="output PNG (default convergence.png)")

@@ -150,25 +150,30 @@ TEST(LightField, APackedSampleKeepsItsCoordinates) {
     EXPECT_NEAR(t.time(), 0.6f, 1e-4f);
 }
 
-TEST(Layers, BlocksWithoutASilhouetteNearAreLeftToTheMethod) {
-    // One silhouette pixel at (40, 33) in a 100x70 image, blocks of 32, a reach of 2: its own
-    // block (32-63, 32-63) and the one above it (2 rows up is that block's last row) are not
-    // left; the block to its left (9 columns away), every other block and the partial ones at
-    // the image's edges are.
+TEST(Layers, PixelsAwayFromASilhouetteAreLeftToTheMethod) {
+    // Silhouette pixels at (40, 33) and at the corner (0, 69) of a 100x70 image, a reach of 1 and
+    // of 2: the squares of 3 and 5 pixels a side around them (clipped at the image's edges) are
+    // not left, every other pixel is.
     Image<uint8_t> mixed(100, 70);
     mixed(40, 33) = 1;
-    const Image<uint8_t> left = filter::blocksWithoutSilhouettes(mixed, 32, 2);
-    for (int y = 0; y < 70; ++y)
-        for (int x = 0; x < 100; ++x) {
-            const bool kept = x >= 32 && x < 64 && y < 64;
-            EXPECT_EQ(left(x, y), kept ? 0 : 1) << x << ", " << y;
-        }
-    // No silhouette: everything left; a silhouette in every block: nothing.
-    const Image<uint8_t> none = filter::blocksWithoutSilhouettes(Image<uint8_t>(100, 70), 32, 2);
+    mixed(0, 69) = 1;
+    for (const int reach : {1, 2}) {
+        const Image<uint8_t> left = filter::pixelsAwayFromSilhouettes(mixed, reach);
+        size_t kept = 0;
+        for (int y = 0; y < 70; ++y)
+            for (int x = 0; x < 100; ++x) {
+                const bool near = (std::abs(x - 40) <= reach && std::abs(y - 33) <= reach) || (x <= reach && y >= 69 - reach);
+                EXPECT_EQ(left(x, y), near ? 0 : 1) << x << ", " << y << ", reach " << reach;
+                kept += !near;
+            }
+        EXPECT_EQ(kept, size_t(100 * 70) - size_t((2 * reach + 1) * (2 * reach + 1)) - size_t((reach + 1) * (reach + 1))) << reach;
+    }
+    // No silhouette: everything left; a silhouette every third pixel with a reach of 1: nothing.
+    const Image<uint8_t> none = filter::pixelsAwayFromSilhouettes(Image<uint8_t>(100, 70), 1);
     EXPECT_TRUE(std::all_of(none.data(), none.data() + none.size(), [](uint8_t v) { return v == 1; }));
-    for (int y = 0; y < 70; y += 16)
-        for (int x = 0; x < 100; x += 16) mixed(x, y) = 1;
-    const Image<uint8_t> all = filter::blocksWithoutSilhouettes(mixed, 32, 2);
+    for (int y = 0; y < 70; y += 3)
+        for (int x = 0; x < 100; x += 3) mixed(x, y) = 1;
+    const Image<uint8_t> all = filter::pixelsAwayFromSilhouettes(mixed, 1);
     EXPECT_TRUE(std::all_of(all.data(), all.data() + all.size(), [](uint8_t v) { return v == 0; }));
 }
 
@@ -585,15 +590,23 @@ TEST(Layers, AnInFocusSceneUnderALensIsTheImageWithoutLayersWithinNoise) {
     }
 }
 
-TEST(Layers, AutoReconstructsForMonteCarloAndAtrousAndABadValueIsAnError) {
-    for (const char* method : {"mc", "aaf", "maaf", "atrous"}) {
-        render::RenderOptions o;
-        o.method = method;
-        o.spp = 4;
-        const render::RenderResult r = renderJson(kDefocusedEdge, o);
-        const bool expected = std::string(method) == "mc" || std::string(method) == "atrous";
-        EXPECT_EQ(r.figure("layers_sample_bytes").has_value(), expected) << method;
-    }
+TEST(Layers, AutoReconstructsForMonteCarloAndAtrousAndForTheFiltersWhereTheSceneMovesAndABadValueIsAnError) {
+    // kDefocusedEdge's half-plane, and the same moving 3 px over the shutter.
+    std::string moving = kDefocusedEdge;
+    moving.replace(moving.find("\"material\": \"white\"}]"), 21, "\"material\": \"white\", \"velocity\": [0.1, 0, 0]}]");
+    ASSERT_TRUE(parse(moving).hasMotion());
+    for (const char* method : {"mc", "aaf", "maaf", "atrous"})
+        for (const bool moves : {false, true}) {
+            render::RenderOptions o;
+            o.method = method;
+            o.spp = 4;
+            const render::RenderResult r = renderJson(moves ? moving : kDefocusedEdge, o);
+            // aaf and maaf have their own defocus filter, and none over the shutter.
+            const bool expected = std::string(method) == "mc" || std::string(method) == "atrous" || moves;
+            EXPECT_EQ(r.figure("layers_sample_bytes").has_value(), expected) << method << (moves ? ", moving" : ", still");
+            o.layers = "off";
+            EXPECT_FALSE(renderJson(moves ? moving : kDefocusedEdge, o).figure("layers_sample_bytes").has_value()) << method;
+        }
     render::RenderOptions high;  // a reference's sample count: plain Monte Carlo
     high.spp = render::RenderOptions::kLayersAutoSpp + 1;
     high.quiet = true;

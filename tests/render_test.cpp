@@ -600,13 +600,13 @@ TEST(Render, ASharpTexturedPixelOnABlurredLayerKeepsItsOwnComposition) {
 }
 
 TEST(Render, AFilterKeepsItsOwnImageAwayFromSilhouettes) {
-    // With layers, aaf and maaf leave the blocks of kSilhouetteBlock pixels with no silhouette
-    // within kSilhouetteReach (no pixel whose samples saw several surfaces) to their own
+    // With layers, aaf and maaf leave the pixels with no silhouette within kSilhouetteReach (no
+    // pixel whose samples saw several surfaces) to their own
     // composition, the image they give without layers: the same pixels, bit for bit (the same
     // samples, texture samples and filters). A checkered floor seen from above through a wide
     // lens, in focus at the image's centre and blurred towards its top and bottom, has no
     // silhouette: the whole image. A checkered wall with a post far out of focus in front of its
-    // left part: the blocks the post's blur reaches are reconstructed, the rest are left.
+    // left part: the pixels by the post's blurred edge are reconstructed, the rest are left.
     const scene::Scene floor = checkeredFloor(1.5, 1.8), wall = checkeredWall(6, kPost);
     for (const char* method : {"aaf", "maaf"}) {
         render::RenderOptions o = layeredOptions(method);
@@ -633,8 +633,8 @@ TEST(Render, AFilterKeepsItsOwnImageAwayFromSilhouettes) {
                 continue;
             }
             if (plain.buffers.coverage[p] < 0.999f) ++silhouette, reconstructed += !equal;
-            // Near the post: some pixel within the block and the reach saw two surfaces.
-            const int x = int(p % 128), y = int(p / 128), r = filter::kSilhouetteBlock + filter::kSilhouetteReach;
+            // Near the post: some pixel within the reach saw two surfaces.
+            const int x = int(p % 128), y = int(p / 128), r = filter::kSilhouetteReach;
             bool near = false;
             for (int yy = std::max(0, y - r); yy <= std::min(31, y + r); ++yy)
                 for (int xx = std::max(0, x - r); xx <= std::min(127, x + r); ++xx) near |= plain.buffers.coverage[size_t(yy) * 128 + xx] < 1.f;

@@ -1229,21 +1229,9 @@ bool samplesSharpAndStill(const LightFieldSamples& lf, size_t p, const ViewGeome
     return sharp;
 }
 
-Image<uint8_t> blocksWithoutSilhouettes(const Image<uint8_t>& mixed, int block, int reach) {
-    const int W = mixed.width(), H = mixed.height(), blocksX = (W + block - 1) / block, blocksY = (H + block - 1) / block;
-    const Image<uint8_t> near = dilateBox(mixed, reach);
-    Image<uint8_t> out(W, H);
-    parallelRows(blocksY, [&](int by) {  // (a row of blocks)
-        for (int bx = 0; bx < blocksX; ++bx) {
-            const int X0 = bx * block, Y0 = by * block, X1 = std::min(W, X0 + block), Y1 = std::min(H, Y0 + block);
-            bool any = false;
-            for (int y = Y0; y < Y1 && !any; ++y)
-                for (int x = X0; x < X1 && !any; ++x) any = near(x, y) != 0;
-            if (!any)
-                for (int y = Y0; y < Y1; ++y)
-                    for (int x = X0; x < X1; ++x) out(x, y) = 1;
-        }
-    });
+Image<uint8_t> pixelsAwayFromSilhouettes(const Image<uint8_t>& mixed, int reach) {
+    Image<uint8_t> out = dilateBox(mixed, reach);
+    for (size_t i = 0; i < out.size(); ++i) out[i] = !out[i];
     return out;
 }
 

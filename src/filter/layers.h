@@ -135,23 +135,23 @@ struct LayerInput {
     const Image<uint8_t>* textured = nullptr;
     std::array<const Image3f*, 1 + FrameBuffers::kOtherSurfaces> surfaceAlbedo{};
     /// Per pixel, 1 where the pixel is left to the method's own composition
-    /// (blocksWithoutSilhouettes): with `own`, own = 1 there and no ray is traced, and a tile
+    /// (pixelsAwayFromSilhouettes): with `own`, own = 1 there and no ray is traced, and a tile
     /// of such pixels alone is not gathered or split either. Null: none is.
     const Image<uint8_t>* methodPixels = nullptr;
 };
 
-/// The blocks (pixels a side) that the renderer leaves to aaf's and maaf's own composition where
-/// no silhouette lies within kSilhouetteReach pixels of them (blocksWithoutSilhouettes). Blocks
-/// of 16 measured better on the textured raster scenes and worse on cornell, whose defocused
-/// surfaces gain from the layers away from silhouettes too; whole tiles of 64 the other way
-/// round (docs/layers.md, "Blocks without a silhouette left to the filters").
-constexpr int kSilhouetteBlock = 32;
-constexpr int kSilhouetteReach = 2;
-/// Per pixel, 1 in each block of `block` x `block` pixels none of whose pixels lies within
-/// `reach` pixels of one where `mixed` is set (its samples saw several surfaces: a silhouette).
-/// Away from silhouettes aaf's and maaf's own composition, their per-surface filters' light
-/// with the defocus filter, measured as good as the layers' (LayerInput::methodPixels).
-Image<uint8_t> blocksWithoutSilhouettes(const Image<uint8_t>& mixed, int block, int reach);
+/// How far from a silhouette (a pixel whose samples saw several surfaces) the renderer leaves a
+/// pixel to aaf's and maaf's own composition (pixelsAwayFromSilhouettes). Per pixel at 1 px
+/// measured better than 32-px blocks at 2 px on nine of eleven scenes with motion (raster-pan
+/// -7%, conference-motion and fast-motion +2-3%) and worse on the lens scenes with `--layers on`
+/// (cornell +5%, whose defocused walls gain from the layers away from silhouettes too;
+/// docs/layers.md, "Pixels away from a silhouette left to the filters").
+constexpr int kSilhouetteReach = 1;
+/// Per pixel, 1 where no pixel within `reach` pixels (a square) is set in `mixed` (its samples
+/// saw several surfaces: a silhouette). There aaf's and maaf's own composition, their
+/// per-surface filters' light with the defocus filter, measured better than the layers'
+/// (LayerInput::methodPixels).
+Image<uint8_t> pixelsAwayFromSilhouettes(const Image<uint8_t>& mixed, int reach);
 
 /// LayerInput::textured's bits: the pixel took texture samples for a surface whose samples there
 /// are sharp and still (kTextureSurface); every sample it holds is sharp and still, and it or a

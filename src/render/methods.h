@@ -77,7 +77,7 @@ constexpr uint32_t kMixedSpp = 64;
 /// (docs/textures.md). Takes the pixels' sample indices on from their path samples' (the same
 /// seed, the same image on any number of threads or ranks). Adds the rays to result.rays and the
 /// pixels' count to result.extra ("texture_pixels"). First, for aaf and maaf with a light field,
-/// marks result.methodPixels (filter::blocksWithoutSilhouettes), where texture samples are taken
+/// marks result.methodPixels (filter::pixelsAwayFromSilhouettes), where texture samples are taken
 /// as without layers.
 void textureSamples(const MethodContext& ctx, PixelStatsImage& stats, RenderResult& result);
 /// The relative variance of a surface's albedo luminance above which a pixel takes texture samples.
@@ -113,7 +113,7 @@ Image3f visibilityImage(const FrameBuffers& fb);
 /// (FrameBuffers::composeFiltered), then, where the camera has a lens, the defocus filter of the
 /// composited radiance (filter/defocus.h).
 /// With ctx.lightField, the layered reconstruction (reconstructFromLayers) takes the place of that
-/// image near silhouettes (result.methodPixels: filter::blocksWithoutSilhouettes).
+/// image near silhouettes (result.methodPixels: filter::pixelsAwayFromSilhouettes).
 Image3f composeFilteredLight(const MethodContext& ctx, const Image3f& filteredVisibility, const Image3f& filteredIndirect,
                              RenderResult& result);
 

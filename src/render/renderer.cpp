@@ -76,12 +76,12 @@ uint64_t denseEmission(const MethodContext& ctx, const Image<uint32_t>& topUp, F
 
 namespace {
 
-/// result.methodPixels for aaf and maaf with a light field: the blocks of the image with no pixel
-/// within filter::kSilhouetteReach of one whose samples saw several surfaces (a miss counts as
-/// another surface, as in the stage), left to their own composition. Each rank marks its own
-/// rows' pixels, and every rank gets the whole mask. (docs/layers.md, "Blocks without a
-/// silhouette left to the filters".)
-void leaveBlocksToTheMethod(const MethodContext& ctx, const PixelStatsImage& stats, RenderResult& result) {
+/// result.methodPixels for aaf and maaf with a light field: the pixels with none within
+/// filter::kSilhouetteReach whose samples saw several surfaces (a miss counts as another surface,
+/// as in the stage), left to their own composition. Each rank marks its own rows' pixels, and
+/// every rank gets the whole mask. (docs/layers.md, "Blocks without a silhouette left to the
+/// filters" and "Pixels away from a silhouette left to the filters".)
+void leavePixelsToTheMethod(const MethodContext& ctx, const PixelStatsImage& stats, RenderResult& result) {
     if (!ctx.lightField || (ctx.options.method != "aaf" && ctx.options.method != "maaf")) return;
     const LightFieldSamples& lf = *ctx.lightField;
     Image<uint8_t> mixed(stats.width(), stats.height());
@@ -96,13 +96,13 @@ void leaveBlocksToTheMethod(const MethodContext& ctx, const PixelStatsImage& sta
         }
     });
     exchangeImageRows(ctx.sampler.distribution(), mixed.data(), stats.width(), stats.height());
-    result.methodPixels = filter::blocksWithoutSilhouettes(mixed, filter::kSilhouetteBlock, filter::kSilhouetteReach);
+    result.methodPixels = filter::pixelsAwayFromSilhouettes(mixed, filter::kSilhouetteReach);
 }
 
 }  // namespace
 
 void textureSamples(const MethodContext& ctx, PixelStatsImage& stats, RenderResult& result) {
-    leaveBlocksToTheMethod(ctx, stats, result);
+    leavePixelsToTheMethod(ctx, stats, result);
     const uint32_t count = uint32_t(std::max(ctx.options.textureSpp, 0));
     if (count == 0) {
         result.extra.emplace_back("texture_pixels", 0.0);
@@ -306,7 +306,7 @@ int renderSpp(const scene::SceneDesc& desc, const RenderOptions& options) {
 }
 
 bool keepsLightField(const scene::SceneDesc& desc, const RenderOptions& options, int spp) {
-    return options.layered(spp) && (desc.camera.apertureRadius > 0 || desc.hasMotion());
+    return options.layered(spp, desc.hasMotion()) && (desc.camera.apertureRadius > 0 || desc.hasMotion());
 }
 
 RenderResult render(const scene::Scene& scene, const RenderOptions& options) {

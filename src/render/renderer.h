@@ -69,9 +69,12 @@ struct RenderOptions {
     std::string sampler = "sobol";
     // The layered reconstruction of defocus and motion blur across pixels (filter/layers.h),
     // where the camera has a lens or the scene moves: "on", "off" (each pixel composes its own
-    // samples by surface, and aaf and maaf apply their defocus filter) or "auto", the measured
-    // better of the two per method: on for mc and atrous up to kLayersAutoSpp samples per pixel,
-    // off for aaf and maaf (docs/layers.md).
+    // samples by surface, and aaf and maaf apply their defocus filter) or "auto", up to
+    // kLayersAutoSpp samples per pixel: on for mc and atrous; for aaf and maaf on where the
+    // scene moves (their filters have none over the shutter: a motion-blurred silhouette kept
+    // its samples' noise, and AAF without layers measured 0.87x MC's efficiency on
+    // docs/bunny-motion.json) and off where only the lens blurs (their own defocus filter is the
+    // more efficient there). docs/layers.md, "`auto` for the filters where the scene moves".
     std::string layers = "auto";
     /// Several ranks rendering one image together (render/distribution.h; the command line's
     /// MPI ranks): every rank calls render() with the same options and gets the same result
@@ -82,9 +85,12 @@ struct RenderOptions {
     /// (16-64), and where the samples it keeps (24 bytes each) fit: a 4096-spp reference at
     /// 512x512 would keep 26 GB and take the stage minutes for what plain Monte Carlo already has.
     static constexpr int kLayersAutoSpp = 64;
-    /// Whether `method` at `spp` samples per pixel reconstructs with layers under this setting.
-    bool layered(int spp) const {
-        return layers == "on" || (layers == "auto" && (method == "mc" || method == "atrous") && spp <= kLayersAutoSpp);
+    /// Whether `method` at `spp` samples per pixel reconstructs with layers under this setting,
+    /// in a scene that moves or not.
+    bool layered(int spp, bool sceneMoves) const {
+        if (layers == "on") return true;
+        if (layers != "auto" || spp > kLayersAutoSpp) return false;
+        return method == "mc" || method == "atrous" || sceneMoves;
     }
 };
 
@@ -99,7 +105,7 @@ struct RenderResult {
     int threads = 0;
     std::vector<std::pair<std::string, double>> extra;  // method-specific figures for --stats
     Image<uint8_t> texturePixels;  // with a light field: where a pixel took texture samples (filter::kTextureSurface, kSharpTextured); empty where none did
-    Image<uint8_t> methodPixels;   // with a light field, for aaf and maaf: the pixels left to their own composition (filter::blocksWithoutSilhouettes); empty otherwise
+    Image<uint8_t> methodPixels;   // with a light field, for aaf and maaf: the pixels left to their own composition (filter::pixelsAwayFromSilhouettes); empty otherwise
     /// The method-specific figure `key`, if the method gave it.
     std::optional<double> figure(const std::string& key) const {
         for (const auto& [k, v] : extra)
