@@ -72,7 +72,7 @@ struct RenderOptions {
     // samples by surface, and aaf and maaf apply their defocus filter) or "auto", up to
     // kLayersAutoSpp samples per pixel: on for mc and atrous; for aaf and maaf on where the
     // scene moves (their filters have none over the shutter: a motion-blurred silhouette kept
-    // its samples' noise, and AAF without layers measured 0.87x MC's efficiency on
+    // its samples' noise, and AAF without layers measured 0.77-0.87x MC's efficiency on
     // docs/bunny-motion.json) and off where only the lens blurs (their own defocus filter is the
     // more efficient there). docs/layers.md, "`auto` for the filters where the scene moves".
     std::string layers = "auto";
