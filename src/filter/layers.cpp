@@ -1289,6 +1289,47 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
     std::atomic<uint64_t> gatheredTotal{0}, layerTotal{0}, blurredTotal{0}, straddlingTotal{0}, leftTotal{0};
     const int apronTiles = (o.maxReach + T - 1) / T;
     const float pad = std::ceil(3.f * o.sigmaMax) + 2.f;
+    // Each tile's margin: the reach of the trajectories that can touch it, and a pad for the
+    // grids' Gaussians.
+    std::vector<int> tileMargin(size_t(tilesX) * tilesY, 0);
+    for (int ty = 0; ty < tilesY; ++ty)
+        for (int tx = 0; tx < tilesX; ++tx) {
+            const int X0 = tx * T, Y0 = ty * T, X1 = std::min(W, X0 + T), Y1 = std::min(H, Y0 + T);
+            float reachT = 0;
+            for (int sy = std::max(0, ty - apronTiles); sy <= std::min(tilesY - 1, ty + apronTiles); ++sy)
+                for (int sx = std::max(0, tx - apronTiles); sx <= std::min(tilesX - 1, tx + apronTiles); ++sx) {
+                    const float r = tileReach[size_t(sy) * tilesX + sx];
+                    const int gapX = std::max({0, sx * T - X1, X0 - std::min(W, (sx + 1) * T)});
+                    const int gapY = std::max({0, sy * T - Y1, Y0 - std::min(H, (sy + 1) * T)});
+                    if (float(std::max(gapX, gapY)) <= r) reachT = std::max(reachT, r);
+                }
+            tileMargin[size_t(ty) * tilesX + tx] = int(std::ceil(reachT + pad));
+        }
+    // The samples each tile gathers (its pixels and its margin), from sums of the counts over
+    // rectangles; a thread's array is made as large as the largest tile's before its first tile.
+    // (Grown tile by tile, each larger tile mapped a new array whose pages the kernel cleared:
+    // on docs/bunny-slats.json, one thread, 193 MB for a largest tile of 52 MB, 4% of the
+    // process in clear_page_erms under the gather.)
+    std::vector<uint64_t> countSum(size_t(W + 1) * (H + 1), 0);
+    for (int y = 0; y < H; ++y) {
+        uint64_t row = 0;
+        for (int x = 0; x < W; ++x) {
+            row += lf.count(size_t(y) * W + x);
+            countSum[size_t(y + 1) * (W + 1) + x + 1] = countSum[size_t(y) * (W + 1) + x + 1] + row;
+        }
+    }
+    auto tileRegion = [&](int tx, int ty) {
+        const int X0 = tx * T, Y0 = ty * T, X1 = std::min(W, X0 + T), Y1 = std::min(H, Y0 + T);
+        const int margin = tileMargin[size_t(ty) * tilesX + tx];
+        return std::array<int, 4>{std::max(0, X0 - margin), std::max(0, Y0 - margin), std::min(W, X1 + margin), std::min(H, Y1 + margin)};
+    };
+    auto regionCount = [&](const std::array<int, 4>& r) {
+        const auto at = [&](int x, int y) { return countSum[size_t(y) * (W + 1) + x]; };
+        return size_t(at(r[2], r[3]) - at(r[0], r[3]) - at(r[2], r[1]) + at(r[0], r[1]));
+    };
+    size_t largestTile = 0;
+    for (int ty = 0; ty < tilesY; ++ty)
+        for (int tx = 0; tx < tilesX; ++tx) largestTile = std::max(largestTile, regionCount(tileRegion(tx, ty)));
     // Each thread's gathered samples and split, kept across its tiles: a tile's array is tens of
     // megabytes, and allocated per tile (the tasks are single tiles) its pages were fresh every
     // time, cleared by the kernel (conference MC 512x512: 2.3% of the process in page clearing
@@ -1313,6 +1354,7 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
         std::vector<std::vector<int>> occupied;
         std::vector<MotionBatch> batch;
         std::vector<uint16_t> sampleLayer;  // per gathered sample: its layer (Split::layerOf)
+        std::vector<uint32_t> pixelStart;   // per pixel of the tile's region (row-major), and one past: its first sample in g
     };
     tbb::enumerable_thread_specific<Scratch> scratch;
     parallelTiles(tilesX, tilesY, 1, [&](int tx0, int tx1, int ty0, int ty1) {
@@ -1336,23 +1378,11 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                         continue;
                     }
                 }
-                // The reach of the trajectories that can touch this tile.
-                float reachT = 0;
-                for (int sy = std::max(0, ty - apronTiles); sy <= std::min(tilesY - 1, ty + apronTiles); ++sy)
-                    for (int sx = std::max(0, tx - apronTiles); sx <= std::min(tilesX - 1, tx + apronTiles); ++sx) {
-                        const float r = tileReach[size_t(sy) * tilesX + sx];
-                        const int gapX = std::max({0, sx * T - X1, X0 - std::min(W, (sx + 1) * T)});
-                        const int gapY = std::max({0, sy * T - Y1, Y0 - std::min(H, (sy + 1) * T)});
-                        if (float(std::max(gapX, gapY)) <= r) reachT = std::max(reachT, r);
-                    }
-                const int margin = int(std::ceil(reachT + pad));
-                const int rx0 = std::max(0, X0 - margin), rx1 = std::min(W, X1 + margin);
-                const int ry0 = std::max(0, Y0 - margin), ry1 = std::min(H, Y1 + margin);
+                const std::array<int, 4> region = tileRegion(tx, ty);
+                const int rx0 = region[0], ry0 = region[1], rx1 = region[2], ry1 = region[3];
                 g.clear();
-                size_t expected = 0;
-                for (int y = ry0; y < ry1; ++y)
-                    for (int x = rx0; x < rx1; ++x) expected += lf.count(size_t(y) * W + x);
-                g.resize(expected);
+                if (g.capacity() < largestTile) g.reserve(largestTile);
+                g.resize(regionCount(region));
                 Gathered* next = g.data();
                 // The slopes of each class, kept in registers while the samples are read (as
                 // range[cls].add(c) they went through memory, a store and a load per sample on
@@ -1362,9 +1392,13 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                 std::fill(lo, lo + kClasses, kInf);
                 std::fill(hi, hi + kClasses, -kInf);
                 bool anyMoving = false;
+                const int rw = rx1 - rx0;
+                std::vector<uint32_t>& pixelStart = local.pixelStart;
+                pixelStart.resize(size_t(rw) * (ry1 - ry0) + 1);
                 for (int y = ry0; y < ry1; ++y)
                     for (int x = rx0; x < rx1; ++x) {
                         const size_t q = size_t(y) * W + x;
+                        pixelStart[size_t(y - ry0) * rw + (x - rx0)] = uint32_t(next - g.data());
                         lf.forEach(q, [&](const LightFieldSample& s) {
                             Gathered a;
                             const Vec2f f = s.film(), l = s.lens(), m = s.motion();
@@ -1390,6 +1424,7 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                         });
                     }
                 assert(next == g.data() + g.size());  // every sample counted was read
+                pixelStart.back() = uint32_t(g.size());
                 gatheredTotal += g.size();
                 const int groups = anyMoving ? groupByMotionField(g, rx0, ry0, rx1, ry1, local.field, lo, hi) : 0;
                 SlopeRange range[kClasses];
@@ -1777,22 +1812,6 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                     const Gathered& s = g[i];
                     const int sl = split.layerOf(s);
                     sampleLayer[i] = uint16_t(sl);
-                    // D of the layers in front, at their shear (as Layer::sharpPosition): where this
-                    // sample shows that they do not cover. Not that of a moving layer it lies in
-                    // front of then (a still post a moving object passes behind, in a tile that
-                    // keeps one order over the shutter since the object is not seen where the post
-                    // hides it): it tells nothing of whether the layer covers there, and counted,
-                    // it took the object's coverage away over the whole shutter (docs/crossing.json
-                    // AAF relMSE -16%: docs/layers.md, "A post a moving object passes behind").
-                    const bool reorder = timeOrder && reordered[size_t(sl)];
-                    for (int k = 0; k < (reorder ? nLayers : sl); ++k) {
-                        if (reorder && !inFront(k, sl, s.t)) continue;
-                        const SplatTarget& l = target[size_t(k)];
-                        if (l.motion) continue;
-                        if (l.inFrontOfAll(s.invDepth, s.t)) continue;
-                        const int ci = l.cellIndex(layerPosition(s, l.sharp, l.c, l.mx, l.my, l.depthRate));
-                        if (ci >= 0) l.d[ci] += 1.f;
-                    }
                     // Its own layer's N, D, W and radiance at its own trajectory's point.
                     const SplatTarget& l = target[size_t(sl)];
                     const Vec2f own = layerPosition(s, l.sharp, s.c, s.mx, s.my, l.depthRate);
@@ -1817,6 +1836,39 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                     a[1] += radiance.x;
                     a[2] += radiance.y;
                     a[3] += radiance.z;
+                }
+                // D of the layers in front of a sample, at their shear (as Layer::sharpPosition):
+                // where it shows that they do not cover. Not that of a moving layer it lies in
+                // front of then (a still post a moving object passes behind, in a tile that keeps
+                // one order over the shutter since the object is not seen where the post hides
+                // it): it tells nothing of whether the layer covers there, and counted, it took
+                // the object's coverage away over the whole shutter (docs/crossing.json AAF relMSE
+                // -16%: docs/layers.md, "A post a moving object passes behind"). The layers with
+                // a motion grid take theirs in the pass below.
+                // A layer at a time, over the samples that can land on its grid: those of the
+                // pixels within its shear's reach of it (a sharp layer's grid is its tile, and a
+                // sample lands at its own position). Sample by sample over every layer in front,
+                // this was 58% of the splat on docs/bunny-slats.json (one thread). D counts whole
+                // samples: the order of the sums does not change it.
+                for (int k = 0; k < nLayers; ++k) {
+                    const SplatTarget& l = target[size_t(k)];
+                    if (l.motion) continue;
+                    const float shear = l.sharp ? 0.f : std::abs(l.c) + chordReach(l.depthRate) * std::sqrt(l.mx * l.mx + l.my * l.my);
+                    const int r = int(std::ceil(shear)) + 1;
+                    const int wx0 = std::max(rx0, l.gx0 - r), wx1 = std::min(rx1, l.gx0 + l.gw + r);
+                    const int wy0 = std::max(ry0, l.gy0 - r), wy1 = std::min(ry1, l.gy0 + l.gh + r);
+                    for (int y = wy0; y < wy1 && wx0 < wx1; ++y) {
+                        const uint32_t i0 = pixelStart[size_t(y - ry0) * rw + (wx0 - rx0)];
+                        const uint32_t i1 = pixelStart[size_t(y - ry0) * rw + (wx1 - rx0)];
+                        for (uint32_t i = i0; i < i1; ++i) {
+                            const int sl = sampleLayer[i];
+                            const Gathered& s = g[i];
+                            if (timeOrder && reordered[size_t(sl)] ? !inFront(k, sl, s.t) : k >= sl) continue;
+                            if (l.inFrontOfAll(s.invDepth, s.t)) continue;
+                            const int ci = l.cellIndex(layerPosition(s, l.sharp, l.c, l.mx, l.my, l.depthRate));
+                            if (ci >= 0) l.d[ci] += 1.f;
+                        }
+                    }
                 }
                 if (anyMotionGrid) {
                     for (size_t k = 0; k < layers.size(); ++k) {
@@ -1907,28 +1959,37 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                             if (b.cell[j] >= 0) accD[b.cell[j]] += 1.f;
                         b.n = 0;
                     };
-                    const int firstWithGrid = withGrid.front();
-                    for (size_t i = 0; i < g.size(); ++i) {
-                        const int sl = sampleLayer[i];
-                        const bool reorder = timeOrder && reordered[size_t(sl)];
-                        if (!reorder && sl <= firstWithGrid) continue;
-                        const Gathered& s = g[i];
-                        for (const int k : withGrid) {
-                            if (!reorder && k >= sl) break;
-                            if (reorder && !inFront(k, sl, s.t)) continue;
-                            const Layer& l = layers[size_t(k)];
-                            const float qx = s.x + l.c * s.u, qy = s.y - l.c * s.v;
-                            const std::array<float, 4>& box = reachBox[size_t(k)];
-                            if (qx < box[0] || qy < box[1] || qx >= box[2] || qy >= box[3]) continue;
-                            if (l.inFrontOfAll(s.invDepth, s.t)) continue;
-                            MotionBatch& b = batch[size_t(k)];
-                            b.qx[b.n] = qx;
-                            b.qy[b.n] = qy;
-                            b.t[b.n] = s.t;
-                            if (++b.n == MotionBatch::kMax) flush(k);
+                    // A layer at a time, over the samples of the pixels within its shear's reach
+                    // of the box its points can count in (reachBox): one pass over all of the
+                    // tile's samples for every layer read them from memory each time.
+                    for (const int k : withGrid) {
+                        const Layer& l = layers[size_t(k)];
+                        const std::array<float, 4>& box = reachBox[size_t(k)];
+                        if (!(box[0] < box[2])) continue;  // (no cell with samples)
+                        const float reachC = std::abs(l.c) + 1.f;
+                        const int wx0 = int(std::max(float(rx0), std::floor(box[0] - reachC)));
+                        const int wx1 = int(std::min(float(rx1), std::ceil(box[2] + reachC)));
+                        const int wy0 = int(std::max(float(ry0), std::floor(box[1] - reachC)));
+                        const int wy1 = int(std::min(float(ry1), std::ceil(box[3] + reachC)));
+                        MotionBatch& b = batch[size_t(k)];
+                        for (int y = wy0; y < wy1 && wx0 < wx1; ++y) {
+                            const uint32_t i0 = pixelStart[size_t(y - ry0) * rw + (wx0 - rx0)];
+                            const uint32_t i1 = pixelStart[size_t(y - ry0) * rw + (wx1 - rx0)];
+                            for (uint32_t i = i0; i < i1; ++i) {
+                                const int sl = sampleLayer[i];
+                                const Gathered& s = g[i];
+                                if (timeOrder && reordered[size_t(sl)] ? !inFront(k, sl, s.t) : k >= sl) continue;
+                                const float qx = s.x + l.c * s.u, qy = s.y - l.c * s.v;
+                                if (qx < box[0] || qy < box[1] || qx >= box[2] || qy >= box[3]) continue;
+                                if (l.inFrontOfAll(s.invDepth, s.t)) continue;
+                                b.qx[b.n] = qx;
+                                b.qy[b.n] = qy;
+                                b.t[b.n] = s.t;
+                                if (++b.n == MotionBatch::kMax) flush(k);
+                            }
                         }
+                        flush(k);
                     }
-                    for (const int k : withGrid) flush(k);
                 }
                 for (Layer& l : layers) {
                     if (!l.sharp) {
