@@ -821,8 +821,22 @@ void smoothRun(std::vector<float>& acc, int gw, int gh, int stride, float sigma,
     for (int k = -r; k <= r; ++k) w[k + r] = std::exp(-0.5f * float(k * k) / (sigma * sigma));
     const size_t cells = size_t(gw) * gh;
     std::vector<float> tmp(cells * n, 0.f);
-    for (int j = 0; j < gh; ++j)
+    // Per row, the columns [lo, hi) the horizontal pass can make non-zero: within r of its cells
+    // with a non-zero channel (empty: lo = hi). A layer's samples cover a part of its grid (an
+    // object, a slat), and elsewhere the sums only add zeros: skipped, the same sums.
+    std::vector<int> lo(size_t(gh), 0), hi(size_t(gh), 0);
+    for (int j = 0; j < gh; ++j) {
+        int first = gw, last = -1;
         for (int i = 0; i < gw; ++i) {
+            const float* in = &acc[(size_t(j) * gw + i) * stride + c0];
+            bool any = false;
+            for (int ch = 0; ch < n; ++ch) any |= in[ch] != 0.f;
+            if (any) first = std::min(first, i), last = i;
+        }
+        if (last >= 0) lo[size_t(j)] = std::max(0, first - r), hi[size_t(j)] = std::min(gw, last + r + 1);
+    }
+    for (int j = 0; j < gh; ++j)
+        for (int i = lo[size_t(j)]; i < hi[size_t(j)]; ++i) {
             float* out = &tmp[(size_t(j) * gw + i) * n];
             for (int k = std::max(-r, -i); k <= std::min(r, gw - 1 - i); ++k) {
                 const float* in = &acc[(size_t(j) * gw + i + k) * stride + c0];
@@ -833,10 +847,12 @@ void smoothRun(std::vector<float>& acc, int gw, int gh, int stride, float sigma,
     for (size_t q = 0; q < cells; ++q) std::fill_n(&acc[q * stride + c0], n, 0.f);
     for (int j = 0; j < gh; ++j)
         for (int k = std::max(-r, -j); k <= std::min(r, gh - 1 - j); ++k) {
+            const int i0 = lo[size_t(j + k)], i1 = hi[size_t(j + k)];
+            if (i0 >= i1) continue;
             const float wk = w[k + r];
             const float* in = &tmp[size_t(j + k) * gw * n];
             float* out = &acc[size_t(j) * gw * stride + c0];
-            for (int i = 0; i < gw; ++i)
+            for (int i = i0; i < i1; ++i)
                 for (int ch = 0; ch < n; ++ch) out[size_t(i) * stride + ch] += wk * in[size_t(i) * n + ch];
         }
 }
