@@ -1413,6 +1413,7 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                 std::fill(lo, lo + kClasses, kInf);
                 std::fill(hi, hi + kClasses, -kInf);
                 bool anyMoving = false;
+                const float invFocus = 1.f / view.focusDistance;  // (ViewGeometry::defocusSlope's, out of the loop)
                 const int rw = rx1 - rx0;
                 std::vector<uint32_t>& pixelStart = local.pixelStart;
                 pixelStart.resize(size_t(rw) * (ry1 - ry0) + 1);
@@ -1432,8 +1433,11 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                             a.my = m.y;
                             a.cls = uint8_t(movesOnScreen(m) ? 1 : 0);
                             anyMoving |= a.cls != 0;
-                            a.c = slopeOf(s, view);
-                            a.invDepth = s.hit() ? 1.f / std::max(s.depth, 1e-6f) : 0.f;
+                            // slopeOf and the inverse depth from one division (the same values).
+                            const float inv = 1.f / std::max(s.hit() ? s.depth : kInf, 1e-6f);
+                            const float slope = view.apertureRadius * view.focalPixels * (inv - invFocus);
+                            a.c = std::isfinite(slope) ? slope : 0.f;
+                            a.invDepth = s.hit() ? inv : 0.f;
                             a.albedo = s.albedo;
                             a.radiance = s.radiance;
                             a.pixel = uint32_t(q);
