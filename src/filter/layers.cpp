@@ -1376,6 +1376,8 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
         std::vector<MotionBatch> batch;
         std::vector<uint16_t> sampleLayer;  // per gathered sample: its layer (Split::layerOf)
         std::vector<uint32_t> pixelStart;   // per pixel of the tile's region (row-major), and one past: its first sample in g
+        std::vector<int> occupiedStill;     // the D pass of the other layers: a layer's cells with samples summed over rectangles,
+        std::vector<uint8_t> near;          // ... and its cells within the margin of one
     };
     tbb::enumerable_thread_specific<Scratch> scratch;
     parallelTiles(tilesX, tilesY, 1, [&](int tx0, int tx1, int ty0, int ty1) {
@@ -1875,13 +1877,41 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                 // sample lands at its own position). Sample by sample over every layer in front,
                 // this was 58% of the splat on docs/bunny-slats.json (one thread). D counts whole
                 // samples: the order of the sums does not change it.
+                // As in the D pass of the layers with a motion grid (below), a D farther than
+                // `margin` cells from all of the layer's cells with samples (N > 0, splatted
+                // above) changes nothing: N / D is 0 wherever the smoothed N is (its Gaussian
+                // reaches rs cells), D's own Gaussian carries a change rs cells, and
+                // resolveCells' fill carries alpha kFillRings cells. Such Ds are not counted
+                // (`near`), and the samples are read only within the shear's reach of the box of
+                // the cells that count. (Tried when the splat counted D sample by sample, it
+                // needed a pass of its own and cost what it saved: docs/layers.md.)
+                std::vector<int>& occupiedStill = local.occupiedStill;
+                std::vector<uint8_t>& near = local.near;
                 for (int k = 0; k < nLayers; ++k) {
                     const SplatTarget& l = target[size_t(k)];
                     if (l.motion) continue;
+                    const int gw = l.gw, gh = l.gh;
+                    summedArea(gw, gh, occupiedStill, [&](int i, int j) { return l.acc[(size_t(j) * gw + i) * l.accStride] > 0.f; });
+                    if (occupiedStill.back() == 0) continue;  // no samples of its own: alpha 0 whatever D is
+                    const Layer& layer = layers[size_t(k)];
+                    const int m = 2 * int(std::ceil(3.f * layer.sigmaCoverage)) + 2 * kFillRings + 2;
+                    near.resize(size_t(gw) * gh);
+                    int cx0 = gw, cy0 = gh, cx1 = -1, cy1 = -1;  // the box of the cells that count
+                    const int ow = gw + 1;
+                    for (int j = 0; j < gh; ++j) {
+                        const int c0 = std::max(0, j - m), c1 = std::min(gh, j + m + 1);
+                        for (int i = 0; i < gw; ++i) {
+                            const int a0 = std::max(0, i - m), a1 = std::min(gw, i + m + 1);
+                            const int* o = occupiedStill.data();
+                            const bool counts = o[c1 * ow + a1] - o[c1 * ow + a0] - o[c0 * ow + a1] + o[c0 * ow + a0] > 0;
+                            near[size_t(j) * gw + i] = counts;
+                            if (counts) cx0 = std::min(cx0, i), cx1 = std::max(cx1, i), cy0 = std::min(cy0, j), cy1 = std::max(cy1, j);
+                        }
+                    }
                     const float shear = l.sharp ? 0.f : std::abs(l.c) + chordReach(l.depthRate) * std::sqrt(l.mx * l.mx + l.my * l.my);
                     const int r = int(std::ceil(shear)) + 1;
-                    const int wx0 = std::max(rx0, l.gx0 - r), wx1 = std::min(rx1, l.gx0 + l.gw + r);
-                    const int wy0 = std::max(ry0, l.gy0 - r), wy1 = std::min(ry1, l.gy0 + l.gh + r);
+                    const int wx0 = std::max(rx0, l.gx0 + cx0 - r), wx1 = std::min(rx1, l.gx0 + cx1 + 1 + r);
+                    const int wy0 = std::max(ry0, l.gy0 + cy0 - r), wy1 = std::min(ry1, l.gy0 + cy1 + 1 + r);
                     for (int y = wy0; y < wy1 && wx0 < wx1; ++y) {
                         const uint32_t i0 = pixelStart[size_t(y - ry0) * rw + (wx0 - rx0)];
                         const uint32_t i1 = pixelStart[size_t(y - ry0) * rw + (wx1 - rx0)];
@@ -1891,7 +1921,7 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                             if (timeOrder && reordered[size_t(sl)] ? !inFront(k, sl, s.t) : k >= sl) continue;
                             if (l.inFrontOfAll(s.invDepth, s.t)) continue;
                             const int ci = l.cellIndex(layerPosition(s, l.sharp, l.c, l.mx, l.my, l.depthRate));
-                            if (ci >= 0) l.d[ci] += 1.f;
+                            if (ci >= 0 && near[size_t(ci)]) l.d[ci] += 1.f;
                         }
                     }
                 }
