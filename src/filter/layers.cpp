@@ -4,6 +4,7 @@
 #include <atomic>
 #include <cassert>
 #include <cmath>
+#include <type_traits>
 #include <vector>
 
 #include <tbb/enumerable_thread_specific.h>
@@ -724,24 +725,35 @@ void splitLayers(Samples& g, const SlopeRange (&range)[kClasses], const float (&
         h.invMin[r.bin] = std::min(h.invMin[r.bin], r.invMin);
         r = Run{};
     };
-    for (Gathered& s : g) {
-        const int b = hist[s.cls].bin((s.cls == 0 ? splitKey.of(s) : s.c) - rate[s.cls] * (s.t - 0.5f));
-        s.bin = uint16_t(b);
-        Run& r = run[s.cls];
-        if (b != r.bin) {
-            flush(s.cls);
-            r.bin = b;
+    // (With still samples alone, as in a tile without motion, the class is 0 for every sample:
+    // known at compile time, the loop indexes no histogram or run by it. The same sums.)
+    auto sumRuns = [&](auto stillOnly) {
+        for (Gathered& s : g) {
+            const int cls = stillOnly ? 0 : s.cls;
+            const int b = hist[cls].bin((cls == 0 ? splitKey.of(s) : s.c) - rate[cls] * (s.t - 0.5f));
+            s.bin = uint16_t(b);
+            Run& r = run[cls];
+            if (b != r.bin) {
+                flush(cls);
+                r.bin = b;
+            }
+            ++r.count;
+            r.c += s.c;
+            r.mx += s.mx;
+            r.my += s.my;
+            r.invDepth += s.invDepth;
+            r.cMin = std::min(r.cMin, s.c);
+            r.cMax = std::max(r.cMax, s.c);
+            r.invMax = std::max(r.invMax, s.invDepth);
+            r.invMin = std::min(r.invMin, s.invDepth);
         }
-        ++r.count;
-        r.c += s.c;
-        r.mx += s.mx;
-        r.my += s.my;
-        r.invDepth += s.invDepth;
-        r.cMin = std::min(r.cMin, s.c);
-        r.cMax = std::max(r.cMax, s.c);
-        r.invMax = std::max(r.invMax, s.invDepth);
-        r.invMin = std::min(r.invMin, s.invDepth);
-    }
+    };
+    bool stillOnly = true;
+    for (int cls = 1; cls < kClasses; ++cls) stillOnly = stillOnly && hist[cls].bins == 0;
+    if (stillOnly)
+        sumRuns(std::true_type{});
+    else
+        sumRuns(std::false_type{});
     for (int cls = 0; cls < kClasses; ++cls) flush(cls);
     std::vector<Layer> layers;
     for (int cls = 0; cls < kClasses; ++cls) {
