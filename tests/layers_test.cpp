@@ -212,6 +212,50 @@ TEST(Layers, AConstantLightFieldStaysConstantAndEmptyTilesGiveNoNaN) {
         }
 }
 
+TEST(Layers, TheDsSkippedFarFromALayersOwnSamplesChangeNoImage) {
+    // A disc in focus, a defocused post in front (slope +5 px), a box moving 30 px over the
+    // shutter just in front of the focus (its layer has a motion grid) and a far wall (-4 px),
+    // each sample of its own random radiance. The stage skips the Ds that lie farther from all
+    // of a layer's own samples than its Gaussians and the ring fill carry (reconstructLayers),
+    // in both of its D passes, and the image must be the one that counts every D, to the bit.
+    // (It fails with the still layers' margin at 1 cell, or with the motion-grid pass's box
+    // without the motion's reach.)
+    const int W = 192, H = 128;
+    const ViewGeometry view = wideLensView(W, H);
+    LightFieldSamples lf(W, H);
+    const int stage = lf.addStage([&](size_t) { return 12u; });
+    std::mt19937 rng(9);
+    std::uniform_real_distribution<float> uni(0.f, 1.f);
+    for (int y = 0; y < H; ++y)
+        for (int x = 0; x < W; ++x) {
+            LightFieldSample* run = lf.run(stage, size_t(y) * W + x);
+            for (int k = 0; k < 12; ++k) {
+                const Vec2f film{uni(rng), uni(rng)}, lens = concentricDisc(uni(rng), uni(rng));
+                const float t = uni(rng);
+                const float px = float(x) + film.x + 5.f * lens.x;  // on the post's sharp image (slope +5 px)
+                const bool post = px > 60.f && px < 75.f;
+                const bool box = !post && std::abs(float(x) + film.x - 30.f * (t - 0.5f) - 140.f) < 12.f && std::abs(float(y) - 90.f) < 20.f;
+                const bool disc = !post && !box && (x - 40) * (x - 40) + (y - 40) * (y - 40) < 300;
+                const float depth = post ? 1.f : box ? 1.9f : disc ? 2.f : 10.f;
+                const Vec2f motion = box ? Vec2f{30.f, 0.f} : Vec2f{0.f, 0.f};
+                run[k] = LightFieldSample::pack(film, lens, t, depth, motion, Vec3f(1.f), Vec3f(uni(rng), uni(rng), uni(rng)),
+                                                post ? 1 : 0);
+            }
+        }
+    filter::LayerStats stats;
+    filter::LayerOptions skipping, counting;
+    counting.countEveryD = true;
+    const Image3f a = filter::reconstructLayers(filter::LayerInput{lf, view, {}}, skipping, &stats);
+    const Image3f b = filter::reconstructLayers(filter::LayerInput{lf, view, {}}, counting, nullptr);
+    EXPECT_GT(stats.layersPerTile, 2.0);
+    EXPECT_GT(stats.blurredTiles, 0.5);
+    for (int y = 0; y < H; ++y)
+        for (int x = 0; x < W; ++x) {
+            ASSERT_TRUE(isFinite(a(x, y))) << x << ", " << y;
+            ASSERT_EQ(std::memcmp(&a(x, y), &b(x, y), sizeof(Vec3f)), 0) << x << ", " << y;
+        }
+}
+
 TEST(Layers, WhereAFilteredLightIsAnotherPointsASampleCarriesItsOwn) {
     // One plane filling the view, every sample of own radiance 0.5; the filtered light of the
     // primary surface is 0.2, of the others 0.9 (albedo 1). In a blurred still layer a sample on

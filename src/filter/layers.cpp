@@ -1271,6 +1271,7 @@ Image<uint8_t> pixelsAwayFromSilhouettes(const Image<uint8_t>& mixed, int reach)
 Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStats* stats, Image<uint8_t>* own) {
     const LightFieldSamples& lf = in.samples;
     const int W = lf.width(), H = lf.height();
+    const bool countEveryD = o.countEveryD;  // (LayerOptions::countEveryD; `o` names other things below)
     Image3f out(W, H);
     if (own) *own = Image<uint8_t>(W, H);
     const ViewGeometry& view = in.view;
@@ -1906,7 +1907,7 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                     summedArea(gw, gh, occupiedStill, [&](int i, int j) { return l.acc[(size_t(j) * gw + i) * l.accStride] > 0.f; });
                     if (occupiedStill.back() == 0) continue;  // no samples of its own: alpha 0 whatever D is
                     const Layer& layer = layers[size_t(k)];
-                    const int m = 2 * int(std::ceil(3.f * layer.sigmaCoverage)) + 2 * kFillRings + 2;
+                    const int m = countEveryD ? gw + gh : 2 * int(std::ceil(3.f * layer.sigmaCoverage)) + 2 * kFillRings + 2;
                     near.resize(size_t(gw) * gh);
                     int cx0 = gw, cy0 = gh, cx1 = -1, cy1 = -1;  // the box of the cells that count
                     const int ow = gw + 1;
@@ -2009,7 +2010,7 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                             if (lastRow[i + 1] > lastRow[i]) bx0 = std::min(bx0, i), bx1 = i;
                         for (int j = 0; j < gh; ++j)
                             if (o[size_t(j + 1) * (gw + 1) + gw] > o[size_t(j) * (gw + 1) + gw]) by0 = std::min(by0, j), by1 = j;
-                        const int m = 2 * int(std::ceil(3.f * l.sigmaCoverage)) + 2 * kFillRings + 2;
+                        const int m = countEveryD ? gw + gh : 2 * int(std::ceil(3.f * l.sigmaCoverage)) + 2 * kFillRings + 2;
                         margin[size_t(k)] = m;
                         // (motionCells' r is at most |dt| maxMotion + 1, |dt| at most chordReach; a cell to spare.)
                         const float reach = float(m) + chordReach(l.depthRate) * l.maxMotion + 2.f;

@@ -116,6 +116,11 @@ struct LayerOptions {
     int mixedRays = 64; // ... where the first `rays` straddle layers (at most 128)
     int movingRays = 128;  // ... and a layer of the tile moves (at most 128; the renderer keeps mixedRays for MC)
     uint32_t seed = 0;  // of the reconstruction rays
+    // Count every sample's D on the grid of each layer in front of it, also where it lies farther
+    // from all of that layer's own samples than can change the layer's coverage (the stage skips
+    // those Ds; for the test that the skip changes no image, layers_test
+    // Layers.TheDsSkippedFarFromALayersOwnSamplesChangeNoImage).
+    bool countEveryD = false;
 };
 
 struct LayerInput {
