@@ -266,6 +266,7 @@ struct Layer {
     // sphere's front moves faster on screen than its silhouette, and the layer's mean motion
     // stretched its blur (layers.cpp, the splat).
     float motionScale = 1, maxMotion = 0;
+    float motionSpread = 0;  // the largest |motion - motionFit.mean| over motionGrid
     std::vector<float> motionGrid;
     // The affine fit of its samples' motion to their sharp position, its centre in film pixels:
     // where a ray or a sample behind starts on the layer (motionShift).
@@ -1384,7 +1385,7 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
         // The D pass of the layers with a motion grid (withGrid): per layer, its cells with
         // samples summed over rectangles, its margin, and the samples behind it, a batch at a time.
         std::vector<int> withGrid, margin;
-        std::vector<std::array<float, 4>> reachBox;
+        std::vector<std::array<float, 4>> reachBox, ownBox;
         std::vector<std::vector<int>> occupied;
         std::vector<MotionBatch> batch;
         std::vector<uint16_t> sampleLayer;  // per gathered sample: its layer (Split::layerOf)
@@ -1956,7 +1957,7 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                             deviation = std::max(deviation, sqr(m[1] - fit.mean.x) + sqr(m[2] - fit.mean.y));
                         }
                         deviation = std::sqrt(deviation);
-                        float reach = 0;
+                        float reach = 0, spread = 0;
                         for (size_t i = 0; i < cells; ++i) {
                             float* m = &motionAcc[k][i * 3];
                             if (m[0] < 0.05f) {
@@ -1968,8 +1969,10 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                             l.motionGrid[2 * i] = m[1];
                             l.motionGrid[2 * i + 1] = m[2];
                             reach = std::max(reach, m[1] * m[1] + m[2] * m[2]);
+                            spread = std::max(spread, sqr(m[1] - fit.mean.x) + sqr(m[2] - fit.mean.y));
                         }
                         l.maxMotion = std::sqrt(reach);
+                        l.motionSpread = std::sqrt(spread);
                     }
                     // Each sample's point on the layers in front of it goes into that layer's
                     // batch, and a full batch's cells are found by one SIMD loop (motionCells):
@@ -1998,6 +2001,10 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                     // and the largest motion's reach of the box of its cells with samples.
                     std::vector<std::array<float, 4>>& reachBox = local.reachBox;
                     reachBox.assign(size_t(nLayers), {kInf, kInf, -kInf, -kInf});
+                    // ... and the box of its cells with samples widened by the margin, where the
+                    // point p of its sharp image must lie (below).
+                    std::vector<std::array<float, 4>>& ownBox = local.ownBox;
+                    ownBox.assign(size_t(nLayers), {kInf, kInf, -kInf, -kInf});
                     for (const int k : withGrid) {
                         const Layer& l = layers[size_t(k)];
                         const int gw = l.gw, gh = l.gh, as = l.accStride();
@@ -2014,9 +2021,11 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                         margin[size_t(k)] = m;
                         // (motionCells' r is at most |dt| maxMotion + 1, |dt| at most chordReach; a cell to spare.)
                         const float reach = float(m) + chordReach(l.depthRate) * l.maxMotion + 2.f;
-                        if (bx1 >= 0)
+                        if (bx1 >= 0) {
                             reachBox[size_t(k)] = {float(l.gx0 + bx0) - reach, float(l.gy0 + by0) - reach, float(l.gx0 + bx1 + 1) + reach,
                                                    float(l.gy0 + by1 + 1) + reach};
+                            ownBox[size_t(k)] = {float(l.gx0 + bx0 - m), float(l.gy0 + by0 - m), float(l.gx0 + bx1 + 1 + m), float(l.gy0 + by1 + 1 + m)};
+                        }
                         batch[size_t(k)].n = 0;
                     }
                     auto flush = [&](int k) {
@@ -2040,6 +2049,14 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                         const int wy0 = int(std::max(float(ry0), std::floor(box[1] - reachC)));
                         const int wy1 = int(std::min(float(ry1), std::ceil(box[3] + reachC)));
                         MotionBatch& b = batch[size_t(k)];
+                        // p = q - dt m, m a bilinear mean of the grid's motions, each within
+                        // motionSpread of the fit's mean: p lies within |dt| motionSpread of q - dt
+                        // mean (two cells to spare for rounding), and where that is outside ownBox no
+                        // cell within the margin of p's has samples (on a bunny moving over a floor
+                        // most of its trail's samples behind it; their D changes nothing).
+                        const std::array<float, 4>& own = ownBox[size_t(k)];
+                        const Vec2f mean = l.motionFit.mean;
+                        const float spread = l.motionSpread;
                         for (int y = wy0; y < wy1 && wx0 < wx1; ++y) {
                             const uint32_t i0 = pixelStart[size_t(y - ry0) * rw + (wx0 - rx0)];
                             const uint32_t i1 = pixelStart[size_t(y - ry0) * rw + (wx1 - rx0)];
@@ -2049,6 +2066,11 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                                 if (timeOrder && reordered[size_t(sl)] ? !inFront(k, sl, s.t) : k >= sl) continue;
                                 const float qx = s.x + l.c * s.u, qy = s.y - l.c * s.v;
                                 if (qx < box[0] || qy < box[1] || qx >= box[2] || qy >= box[3]) continue;
+                                if (!countEveryD) {
+                                    const float dt = alongChord(s.t - 0.5f, l.depthRate), r = std::abs(dt) * spread + 2.f;
+                                    const float px = qx - dt * mean.x, py = qy - dt * mean.y;
+                                    if (px < own[0] - r || py < own[1] - r || px >= own[2] + r || py >= own[3] + r) continue;
+                                }
                                 if (l.inFrontOfAll(s.invDepth, s.t)) continue;
                                 b.qx[b.n] = qx;
                                 b.qy[b.n] = qy;
