@@ -1899,6 +1899,21 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                 // (`near`), and the samples are read only within the shear's reach of the box of
                 // the cells that count. (Tried when the splat counted D sample by sample, it
                 // needed a pass of its own and cost what it saved: docs/layers.md.)
+                // fn(s) for each sample of the region's pixels [wx0, wx1) x [wy0, wy1) that lies
+                // behind layer k: in a layer after it, or where the two change order over the
+                // shutter, behind it at the sample's time.
+                auto forEachBehind = [&](int k, int wx0, int wx1, int wy0, int wy1, auto&& fn) {
+                    for (int y = wy0; y < wy1 && wx0 < wx1; ++y) {
+                        const uint32_t i0 = pixelStart[size_t(y - ry0) * rw + (wx0 - rx0)];
+                        const uint32_t i1 = pixelStart[size_t(y - ry0) * rw + (wx1 - rx0)];
+                        for (uint32_t i = i0; i < i1; ++i) {
+                            const int sl = sampleLayer[i];
+                            const Gathered& s = g[i];
+                            if (timeOrder && reordered[size_t(sl)] ? !inFront(k, sl, s.t) : k >= sl) continue;
+                            fn(s);
+                        }
+                    }
+                };
                 std::vector<int>& occupiedStill = local.occupiedStill;
                 std::vector<uint8_t>& near = local.near;
                 for (int k = 0; k < nLayers; ++k) {
@@ -1926,18 +1941,11 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                     const int r = int(std::ceil(shear)) + 1;
                     const int wx0 = std::max(rx0, l.gx0 + cx0 - r), wx1 = std::min(rx1, l.gx0 + cx1 + 1 + r);
                     const int wy0 = std::max(ry0, l.gy0 + cy0 - r), wy1 = std::min(ry1, l.gy0 + cy1 + 1 + r);
-                    for (int y = wy0; y < wy1 && wx0 < wx1; ++y) {
-                        const uint32_t i0 = pixelStart[size_t(y - ry0) * rw + (wx0 - rx0)];
-                        const uint32_t i1 = pixelStart[size_t(y - ry0) * rw + (wx1 - rx0)];
-                        for (uint32_t i = i0; i < i1; ++i) {
-                            const int sl = sampleLayer[i];
-                            const Gathered& s = g[i];
-                            if (timeOrder && reordered[size_t(sl)] ? !inFront(k, sl, s.t) : k >= sl) continue;
-                            if (l.inFrontOfAll(s.invDepth, s.t)) continue;
-                            const int ci = l.cellIndex(layerPosition(s, l.sharp, l.c, l.mx, l.my, l.depthRate));
-                            if (ci >= 0 && near[size_t(ci)]) l.d[ci] += 1.f;
-                        }
-                    }
+                    forEachBehind(k, wx0, wx1, wy0, wy1, [&](const Gathered& s) {
+                        if (l.inFrontOfAll(s.invDepth, s.t)) return;
+                        const int ci = l.cellIndex(layerPosition(s, l.sharp, l.c, l.mx, l.my, l.depthRate));
+                        if (ci >= 0 && near[size_t(ci)]) l.d[ci] += 1.f;
+                    });
                 }
                 if (anyMotionGrid) {
                     for (size_t k = 0; k < layers.size(); ++k) {
@@ -2057,27 +2065,20 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                         const std::array<float, 4>& own = ownBox[size_t(k)];
                         const Vec2f mean = l.motionFit.mean;
                         const float spread = l.motionSpread;
-                        for (int y = wy0; y < wy1 && wx0 < wx1; ++y) {
-                            const uint32_t i0 = pixelStart[size_t(y - ry0) * rw + (wx0 - rx0)];
-                            const uint32_t i1 = pixelStart[size_t(y - ry0) * rw + (wx1 - rx0)];
-                            for (uint32_t i = i0; i < i1; ++i) {
-                                const int sl = sampleLayer[i];
-                                const Gathered& s = g[i];
-                                if (timeOrder && reordered[size_t(sl)] ? !inFront(k, sl, s.t) : k >= sl) continue;
-                                const float qx = s.x + l.c * s.u, qy = s.y - l.c * s.v;
-                                if (qx < box[0] || qy < box[1] || qx >= box[2] || qy >= box[3]) continue;
-                                if (!countEveryD) {
-                                    const float dt = alongChord(s.t - 0.5f, l.depthRate), r = std::abs(dt) * spread + 2.f;
-                                    const float px = qx - dt * mean.x, py = qy - dt * mean.y;
-                                    if (px < own[0] - r || py < own[1] - r || px >= own[2] + r || py >= own[3] + r) continue;
-                                }
-                                if (l.inFrontOfAll(s.invDepth, s.t)) continue;
-                                b.qx[b.n] = qx;
-                                b.qy[b.n] = qy;
-                                b.t[b.n] = s.t;
-                                if (++b.n == MotionBatch::kMax) flush(k);
+                        forEachBehind(k, wx0, wx1, wy0, wy1, [&](const Gathered& s) {
+                            const float qx = s.x + l.c * s.u, qy = s.y - l.c * s.v;
+                            if (qx < box[0] || qy < box[1] || qx >= box[2] || qy >= box[3]) return;
+                            if (!countEveryD) {
+                                const float dt = alongChord(s.t - 0.5f, l.depthRate), r = std::abs(dt) * spread + 2.f;
+                                const float px = qx - dt * mean.x, py = qy - dt * mean.y;
+                                if (px < own[0] - r || py < own[1] - r || px >= own[2] + r || py >= own[3] + r) return;
                             }
-                        }
+                            if (l.inFrontOfAll(s.invDepth, s.t)) return;
+                            b.qx[b.n] = qx;
+                            b.qy[b.n] = qy;
+                            b.t[b.n] = s.t;
+                            if (++b.n == MotionBatch::kMax) flush(k);
+                        });
                         flush(k);
                     }
                 }
