@@ -57,8 +57,11 @@ struct ViewGeometry {
     /// World size of one pixel at depth z along forward.
     float pixelFootprint(float depth) const { return depth / focalPixels; }
     /// Defocus slope of a hit at depth z (NOTES, MYRD14): pixels per unit lens coordinate.
-    float defocusSlope(float depth) const {
-        return apertureRadius * focalPixels * (1.f / std::max(depth, 1e-6f) - 1.f / focusDistance);
+    float defocusSlope(float depth) const { return defocusSlopeAt(1.f / std::max(depth, 1e-6f), 1.f / focusDistance); }
+    /// The same from 1 / max(z, 1e-6) and 1 / focusDistance, for a caller that has the one
+    /// already and keeps the other out of its loop (the same value).
+    float defocusSlopeAt(float inverseDepth, float inverseFocus) const {
+        return apertureRadius * focalPixels * (inverseDepth - inverseFocus);
     }
 };
 

@@ -149,9 +149,13 @@ inline bool movesOnScreen(Vec2f m) { return m.x * m.x + m.y * m.y > kMoving * kM
 
 /// A sample's defocus slope (pixels per unit of lens radius). A non-finite slope, which no valid
 /// scene gives, counts as in focus: every sample must fall in a slope bin of its class.
-inline float slopeOf(const LightFieldSample& s, const ViewGeometry& view) {
-    const float slope = view.defocusSlope(s.hit() ? s.depth : kInf);
+/// From the sample's 1 / max(depth, 1e-6) (0 for a miss) and the view's 1 / focusDistance.
+inline float slopeAt(float inverseDepth, const ViewGeometry& view, float inverseFocus) {
+    const float slope = view.defocusSlopeAt(inverseDepth, inverseFocus);
     return std::isfinite(slope) ? slope : 0.f;
+}
+inline float slopeOf(const LightFieldSample& s, const ViewGeometry& view) {
+    return slopeAt(1.f / std::max(s.hit() ? s.depth : kInf, 1e-6f), view, 1.f / view.focusDistance);
 }
 
 /// The cell of a grid whose cell (i, j) covers the pixel [gx0 + i, gx0 + i + 1) x [gy0 + j, gy0 + j
@@ -1429,7 +1433,7 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                 std::fill(lo, lo + kClasses, kInf);
                 std::fill(hi, hi + kClasses, -kInf);
                 bool anyMoving = false;
-                const float invFocus = 1.f / view.focusDistance;  // (ViewGeometry::defocusSlope's, out of the loop)
+                const float invFocus = 1.f / view.focusDistance;  // (out of the loop: slopeAt)
                 const int rw = rx1 - rx0;
                 std::vector<uint32_t>& pixelStart = local.pixelStart;
                 pixelStart.resize(size_t(rw) * (ry1 - ry0) + 1);
@@ -1451,8 +1455,7 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                             anyMoving |= a.cls != 0;
                             // slopeOf and the inverse depth from one division (the same values).
                             const float inv = 1.f / std::max(s.hit() ? s.depth : kInf, 1e-6f);
-                            const float slope = view.apertureRadius * view.focalPixels * (inv - invFocus);
-                            a.c = std::isfinite(slope) ? slope : 0.f;
+                            a.c = slopeAt(inv, view, invFocus);
                             a.invDepth = s.hit() ? inv : 0.f;
                             a.albedo = s.albedo;
                             a.radiance = s.radiance;
