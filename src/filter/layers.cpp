@@ -1276,7 +1276,14 @@ Image<uint8_t> pixelsAwayFromSilhouettes(const Image<uint8_t>& mixed, int reach)
 Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStats* stats, Image<uint8_t>* own) {
     const LightFieldSamples& lf = in.samples;
     const int W = lf.width(), H = lf.height();
-    const bool countEveryD = o.countEveryD;  // (LayerOptions::countEveryD; `o` names other things below)
+    // How far from all of a layer's cells with samples a D can still change its coverage, in
+    // cells (both D passes skip the Ds beyond it): the Gaussians of N and of D reach rs cells
+    // each, resolveCells' fill carries alpha kFillRings cells; with LayerOptions::countEveryD,
+    // the whole grid.
+    const bool countEveryD = o.countEveryD;
+    auto dMargin = [countEveryD](const Layer& l) {
+        return countEveryD ? l.gw + l.gh : 2 * int(std::ceil(3.f * l.sigmaCoverage)) + 2 * kFillRings + 2;
+    };
     Image3f out(W, H);
     if (own) *own = Image<uint8_t>(W, H);
     const ViewGeometry& view = in.view;
@@ -1895,13 +1902,11 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                 // this was 58% of the splat on docs/bunny-slats.json (one thread). D counts whole
                 // samples: the order of the sums does not change it.
                 // As in the D pass of the layers with a motion grid (below), a D farther than
-                // `margin` cells from all of the layer's cells with samples (N > 0, splatted
-                // above) changes nothing: N / D is 0 wherever the smoothed N is (its Gaussian
-                // reaches rs cells), D's own Gaussian carries a change rs cells, and
-                // resolveCells' fill carries alpha kFillRings cells. Such Ds are not counted
-                // (`near`), and the samples are read only within the shear's reach of the box of
-                // the cells that count. (Tried when the splat counted D sample by sample, it
-                // needed a pass of its own and cost what it saved: docs/layers.md.)
+                // dMargin from all of the layer's cells with samples (N > 0, splatted above)
+                // changes nothing: such Ds are not counted (`near`), and the samples are read only
+                // within the shear's reach of the box of the cells that count. (Tried when the
+                // splat counted D sample by sample, it needed a pass of its own and cost what it
+                // saved: docs/layers.md.)
                 // fn(s) for each sample of the region's pixels [wx0, wx1) x [wy0, wy1) that lies
                 // behind layer k: in a layer after it, or where the two change order over the
                 // shutter, behind it at the sample's time.
@@ -1925,16 +1930,15 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                     const int gw = l.gw, gh = l.gh;
                     summedArea(gw, gh, occupiedStill, [&](int i, int j) { return l.acc[(size_t(j) * gw + i) * l.accStride] > 0.f; });
                     if (occupiedStill.back() == 0) continue;  // no samples of its own: alpha 0 whatever D is
-                    const Layer& layer = layers[size_t(k)];
-                    const int m = countEveryD ? gw + gh : 2 * int(std::ceil(3.f * layer.sigmaCoverage)) + 2 * kFillRings + 2;
+                    const int m = dMargin(layers[size_t(k)]);
                     near.resize(size_t(gw) * gh);
                     int cx0 = gw, cy0 = gh, cx1 = -1, cy1 = -1;  // the box of the cells that count
                     const int ow = gw + 1;
+                    const int* o = occupiedStill.data();
                     for (int j = 0; j < gh; ++j) {
                         const int c0 = std::max(0, j - m), c1 = std::min(gh, j + m + 1);
                         for (int i = 0; i < gw; ++i) {
                             const int a0 = std::max(0, i - m), a1 = std::min(gw, i + m + 1);
-                            const int* o = occupiedStill.data();
                             const bool counts = o[c1 * ow + a1] - o[c1 * ow + a0] - o[c0 * ow + a1] + o[c0 * ow + a0] > 0;
                             near[size_t(j) * gw + i] = counts;
                             if (counts) cx0 = std::min(cx0, i), cx1 = std::max(cx1, i), cy0 = std::min(cy0, j), cy1 = std::max(cy1, j);
@@ -1992,7 +1996,7 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                     // docs/bunny-slats.json (about 45 ns a sample and layer); a layer at a time,
                     // it read the samples once per layer from memory. D counts whole samples: the
                     // order of the sums does not change it.
-                    // A D farther than `margin` cells from all of the layer's cells with samples
+                    // A D farther than dMargin from all of the layer's cells with samples
                     // (N > 0) changes nothing: N / D is 0 wherever the smoothed N is (its
                     // Gaussian reaches rs cells), D's own Gaussian carries a change rs cells, and
                     // resolveCells' fill carries alpha kFillRings cells, so such a D changes D
@@ -2028,7 +2032,7 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                             if (lastRow[i + 1] > lastRow[i]) bx0 = std::min(bx0, i), bx1 = i;
                         for (int j = 0; j < gh; ++j)
                             if (o[size_t(j + 1) * (gw + 1) + gw] > o[size_t(j) * (gw + 1) + gw]) by0 = std::min(by0, j), by1 = j;
-                        const int m = countEveryD ? gw + gh : 2 * int(std::ceil(3.f * l.sigmaCoverage)) + 2 * kFillRings + 2;
+                        const int m = dMargin(l);
                         margin[size_t(k)] = m;
                         // (motionCells' r is at most |dt| maxMotion + 1, |dt| at most chordReach; a cell to spare.)
                         const float reach = float(m) + chordReach(l.depthRate) * l.maxMotion + 2.f;
