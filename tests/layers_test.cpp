@@ -612,6 +612,47 @@ TEST(Layers, WithoutDefocusAndMotionTheImageIsTheOneWithoutLayers) {
     }
 }
 
+TEST(Layers, TheFiltersKeepOnlyTheAdaptiveSamplesThatCarryVisibility) {
+    // A lit floor filling the view under a lens focused on it, with the soft shadow of a bar
+    // outside the view: every pixel's samples see one untextured surface, so the samples aaf
+    // and maaf add for their filters' rates carry only light the stage has from the initial
+    // ones, and the light field keeps the initial samples alone (visibilitySamplePixels).
+    // With the bar in view its silhouette's pixels keep theirs.
+    const std::string floor = R"({
+      "camera": {"position": [0, 1, 0], "look_at": [0, 0, 0], "up": [0, 0, -1], "fov_y": 40, "resolution": [24, 24],
+                 "aperture_radius": 0.02, "focus_distance": 1},
+      "materials": {"grey": {"albedo": [0.6, 0.6, 0.6]}},
+      "lights": [{"type": "parallelogram", "corner": [1.2, 3, -0.3], "edge1": [0.6, 0, 0], "edge2": [0, 0, 0.6], "radiance": [30, 30, 30]}],
+      "objects": [{"type": "quad", "corner": [-3, 0, 3], "edge1": [6, 0, 0], "edge2": [0, 0, -6], "material": "grey"},
+                  {"type": "box", "min": BOX_MIN, "max": BOX_MAX, "material": "grey"}],
+      "render": {"spp": 8, "seed": 3, "indirect": true}
+    })";
+    auto withBar = [&](const std::string& min, const std::string& max) {
+        std::string json = floor;
+        json.replace(json.find("BOX_MIN"), 7, min);
+        json.replace(json.find("BOX_MAX"), 7, max);
+        return json;
+    };
+    const size_t pixels = 24 * 24, n0 = 8;
+    const double stageBytes = double(2 * (pixels + 1) * sizeof(uint64_t));  // the initial and adaptive stages' offsets
+    for (const char* method : {"aaf", "maaf"}) {
+        render::RenderOptions o;
+        o.method = method;
+        o.layers = "on";
+        o.spp = int(n0);
+        // The bar beside the view, between the floor and the light: its penumbra crosses the view.
+        const render::RenderResult outside = renderJson(withBar("[0.6, 1.2, -2]", "[0.75, 1.3, 2]"), o);
+        ASSERT_GT(outside.sppAverage, double(n0) + 1) << method << ": the filters' rates took no samples; the test shows nothing";
+        ASSERT_TRUE(outside.figure("layers_sample_bytes").has_value()) << method;
+        EXPECT_EQ(*outside.figure("layers_sample_bytes"), double(pixels * n0 * sizeof(LightFieldSample)) + stageBytes) << method;
+        // The bar in view (under the camera, over the floor): its silhouette's pixels keep more.
+        const render::RenderResult inside = renderJson(withBar("[-0.05, 0.3, -2]", "[0.05, 0.35, 2]"), o);
+        ASSERT_TRUE(inside.figure("layers_sample_bytes").has_value()) << method;
+        EXPECT_GT(*inside.figure("layers_sample_bytes"), double(pixels * n0 * sizeof(LightFieldSample)) + stageBytes) << method;
+        EXPECT_LT(*inside.figure("layers_sample_bytes"), inside.sppAverage * pixels * sizeof(LightFieldSample) + stageBytes) << method;
+    }
+}
+
 TEST(Layers, AnInFocusSceneUnderALensIsTheImageWithoutLayersWithinNoise) {
     // A textured wall in the plane of focus: every layer is sharp (its pixels' own samples).
     const std::string json = R"({

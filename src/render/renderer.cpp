@@ -54,6 +54,15 @@ Image<uint32_t> emitterTopUps(const PixelStatsImage& stats, uint32_t target) {
     return extra;
 }
 
+Image<uint8_t> visibilitySamplePixels(const PixelStatsImage& stats, const Image<uint32_t>& emitterExtra) {
+    Image<uint8_t> keep(stats.width(), stats.height());
+    parallelRows(stats.height(), [&](int y) {
+        for (size_t p = size_t(y) * stats.width(); p < size_t(y + 1) * stats.width(); ++p)
+            keep[p] = stats[p].mixed() || emitterExtra[p] > 0 || stats[p].albedoVariance() > kTextureVariance;
+    });
+    return keep;
+}
+
 uint64_t denseEmission(const MethodContext& ctx, const Image<uint32_t>& topUp, FrameBuffers& fb) {
     std::atomic<uint64_t> rays{0};
     parallelRows(fb.height, [&](int y) {

@@ -32,10 +32,11 @@ public:
         m_fill.assign(size_t(m_lf->width()) * m_lf->height(), 0);
     }
     /// Sample s of pixel (x, y), which PixelStats::add put in surface slot `slot`. Each pixel's
-    /// samples come from one thread, in order.
+    /// samples come from one thread, in order; the stage keeps the first count(p) of them.
     void record(int x, int y, const TracedSample& s, int slot) {
         if (!m_lf) return;
         const size_t p = size_t(y) * m_lf->width() + x;
+        if (m_fill[p] == m_lf->runLength(m_stage, p)) return;
         const SampleRecord& r = s.record;
         m_lf->run(m_stage, p)[m_fill[p]++] = LightFieldSample::pack(
             s.film, r.lens, s.time, s.hit ? s.depth : kInf, s.motion, s.albedo, s.albedo * (r.direct + r.indirect), slot);
