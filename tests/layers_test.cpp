@@ -653,6 +653,29 @@ TEST(Layers, TheFiltersKeepOnlyTheAdaptiveSamplesThatCarryVisibility) {
     }
 }
 
+TEST(Layers, TheFiltersFirstRaysAreMixedRaysWhereTheyLeaveThePixelsAwayFromSilhouettes) {
+    // kDefocusedEdge's half-plane moving 3 px over the shutter: every tile has a moving blurred
+    // layer, so a pixel whose first rays straddle layers takes movingRays in all (mc, whose
+    // samples carry their own radiance: mixedRays). aaf and maaf keep their own image away from
+    // silhouettes, and there a pixel's first rays are mixedRays; mc's are `rays`. So the rays of
+    // the pixels that trace several but do not straddle, per such pixel, are those.
+    std::string moving = kDefocusedEdge;
+    moving.replace(moving.find("\"material\": \"white\"}]"), 21, "\"material\": \"white\", \"velocity\": [0.1, 0, 0]}]");
+    const filter::LayerOptions lo;
+    for (const char* method : {"aaf", "maaf", "mc"}) {
+        render::RenderOptions o;
+        o.method = method;
+        o.layers = "on";
+        const render::RenderResult r = renderJson(moving, o);
+        const double multi = r.figure("layers_multi_ray_pixels").value_or(0), rays = r.figure("layers_rays_per_pixel").value_or(0),
+                     straddling = r.figure("layers_straddling_pixels").value_or(0);
+        const bool filtered = std::string(method) != "mc";
+        ASSERT_GT(multi - straddling, 0.05) << method << ": too few pixels trace several rays without straddling for the test to show anything";
+        const double first = (rays - straddling * (filtered ? lo.movingRays : lo.mixedRays)) / (multi - straddling);
+        EXPECT_NEAR(first, filtered ? lo.mixedRays : lo.rays, 1e-6) << method;
+    }
+}
+
 TEST(Layers, AnInFocusSceneUnderALensIsTheImageWithoutLayersWithinNoise) {
     // A textured wall in the plane of focus: every layer is sharp (its pixels' own samples).
     const std::string json = R"({

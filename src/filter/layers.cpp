@@ -1332,7 +1332,7 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
             }
         });
     }
-    std::atomic<uint64_t> gatheredTotal{0}, layerTotal{0}, blurredTotal{0}, straddlingTotal{0}, leftTotal{0};
+    std::atomic<uint64_t> gatheredTotal{0}, layerTotal{0}, blurredTotal{0}, straddlingTotal{0}, leftTotal{0}, multiRayTotal{0}, rayTotal{0};
     const int apronTiles = (o.maxReach + T - 1) / T;
     const float pad = std::ceil(3.f * o.sigmaMax) + 2.f;
     // Each tile's margin: the reach of the trajectories that can touch it, and a pad for the
@@ -2133,7 +2133,7 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                     }
 
                 // Reconstruction rays, composited front to back.
-                uint64_t straddling = 0;
+                uint64_t straddling = 0, multiRay = 0, raysTraced = 0;
                 for (int y = Y0; y < Y1; ++y)
                     for (int x = X0; x < X1; ++x) {
                         if (left && (*left)(x, y)) {
@@ -2338,8 +2338,12 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                             sum += t > 1e-4f && t < 1.f ? c / (1.f - t) : c;
                         }
                         out(x, y) = sum / float(pixelRays);
+                        multiRay += pixelRays > 1;
+                        raysTraced += uint64_t(pixelRays);
                     }
                 straddlingTotal += straddling;
+                multiRayTotal += multiRay;
+                rayTotal += raysTraced;
             }
     });
     if (stats) {
@@ -2347,6 +2351,8 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
         stats->layersPerTile = double(layerTotal) / double(size_t(tilesX) * tilesY);
         stats->blurredTiles = double(blurredTotal) / double(size_t(tilesX) * tilesY);
         stats->straddlingPixels = double(straddlingTotal) / double(std::max<size_t>(1, size_t(W) * H));
+        stats->multiRayPixels = double(multiRayTotal) / double(std::max<size_t>(1, size_t(W) * H));
+        stats->raysPerPixel = double(rayTotal) / double(std::max<size_t>(1, size_t(W) * H));
         stats->methodTiles = double(leftTotal) / double(size_t(tilesX) * tilesY);
     }
     return out;

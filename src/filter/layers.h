@@ -172,6 +172,8 @@ struct LayerStats {
     double layersPerTile = 0;
     double blurredTiles = 0;      // fraction of tiles with a reprojected (blurred) layer
     double straddlingPixels = 0;  // fraction of pixels whose first rays straddled layers (and took mixedRays)
+    double multiRayPixels = 0;    // fraction of pixels that traced more than one reconstruction ray
+    double raysPerPixel = 0;      // reconstruction rays traced, per pixel of the image
     double methodTiles = 0;       // fraction of tiles left whole to the method's own composition (LayerInput::methodPixels)
 };
 
