@@ -549,6 +549,8 @@ struct FieldScratch {
     std::vector<Cluster> clusters;  // kCellClusters per cell
     std::vector<uint8_t> used;      // per cell
     std::vector<int> parent, group;  // per cluster
+    std::vector<int> clusterGroup;   // per cluster: its group (group[find(cluster)]), resolved once
+    std::vector<uint32_t> sampleCell;  // per sample: its cell (moving samples only)
 };
 inline float fieldTolerance2(float mx, float my) {
     return sqr(std::max(kFieldTolerance, kFieldToleranceRel * std::sqrt(mx * mx + my * my)));
@@ -566,11 +568,14 @@ int groupByMotionField(Samples& g, int x0, int y0, int x1, int y1, FieldScratch&
     };
     f.used.assign(cells, 0);
     f.clusters.resize(cells * kCellClusters);
+    f.sampleCell.resize(g.size());
     bool any = false;
-    for (auto& a : g) {
+    for (size_t si = 0; si < g.size(); ++si) {
+        auto& a = g[si];
         if (a.cls == 0) continue;
         any = true;
         const size_t cell = cellOf(a);
+        f.sampleCell[si] = uint32_t(cell);
         FieldScratch::Cluster* c = &f.clusters[cell * kCellClusters];
         const int used = f.used[cell];
         int k = 0, nearest = 0;
@@ -661,11 +666,20 @@ int groupByMotionField(Samples& g, int x0, int y0, int x1, int y1, FieldScratch&
             f.group[size_t(overflow[o])] = nearest;
         }
     }
+    // Each cluster's group, found once (not once per sample: the samples' cells and the
+    // union-find walks were a third of this function on raster-pan).
+    f.clusterGroup.resize(cells * kCellClusters);
+    for (size_t cell = 0; cell < cells; ++cell)
+        for (int k = 0; k < f.used[cell]; ++k) {
+            const size_t i = cell * kCellClusters + size_t(k);
+            f.clusterGroup[i] = f.group[size_t(find(int(i)))];
+        }
     for (int k = 1; k < kClasses; ++k) lo[k] = kInf, hi[k] = -kInf;
-    for (auto& a : g) {
+    for (size_t si = 0; si < g.size(); ++si) {
+        auto& a = g[si];
         if (a.cls == 0) continue;
-        const size_t i = cellOf(a) * kCellClusters + size_t(a.cls - 1);
-        a.cls = uint8_t(1 + f.group[size_t(find(int(i)))]);
+        const size_t i = size_t(f.sampleCell[si]) * kCellClusters + size_t(a.cls - 1);
+        a.cls = uint8_t(1 + f.clusterGroup[i]);
         lo[a.cls] = std::min(lo[a.cls], a.c);
         hi[a.cls] = std::max(hi[a.cls], a.c);
     }
