@@ -548,8 +548,7 @@ struct FieldScratch {
     };
     std::vector<Cluster> clusters;  // kCellClusters per cell
     std::vector<uint8_t> used;      // per cell
-    std::vector<int> parent, group;  // per cluster
-    std::vector<int> clusterGroup;   // per cluster: its group (group[find(cluster)]), resolved once
+    std::vector<int> parent, group;  // per cluster (group: at its root, then resolved for every cluster)
     std::vector<uint32_t> sampleCell;  // per sample: its cell (moving samples only)
 };
 inline float fieldTolerance2(float mx, float my) {
@@ -667,19 +666,19 @@ int groupByMotionField(Samples& g, int x0, int y0, int x1, int y1, FieldScratch&
         }
     }
     // Each cluster's group, found once (not once per sample: the samples' cells and the
-    // union-find walks were a third of this function on raster-pan).
-    f.clusterGroup.resize(cells * kCellClusters);
+    // union-find walks were a third of this function on raster-pan). In place: a root's own
+    // entry is its group already and stays.
     for (size_t cell = 0; cell < cells; ++cell)
         for (int k = 0; k < f.used[cell]; ++k) {
             const size_t i = cell * kCellClusters + size_t(k);
-            f.clusterGroup[i] = f.group[size_t(find(int(i)))];
+            f.group[i] = f.group[size_t(find(int(i)))];
         }
     for (int k = 1; k < kClasses; ++k) lo[k] = kInf, hi[k] = -kInf;
     for (size_t si = 0; si < g.size(); ++si) {
         auto& a = g[si];
         if (a.cls == 0) continue;
         const size_t i = size_t(f.sampleCell[si]) * kCellClusters + size_t(a.cls - 1);
-        a.cls = uint8_t(1 + f.clusterGroup[i]);
+        a.cls = uint8_t(1 + f.group[i]);
         lo[a.cls] = std::min(lo[a.cls], a.c);
         hi[a.cls] = std::max(hi[a.cls], a.c);
     }
@@ -1291,9 +1290,11 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
     const LightFieldSamples& lf = in.samples;
     const int W = lf.width(), H = lf.height();
     // How far from all of a layer's cells with samples a D can still change its coverage, in
-    // cells (both D passes skip the Ds beyond it): the Gaussians of N and of D reach rs cells
-    // each, resolveCells' fill carries alpha kFillRings cells; with LayerOptions::countEveryD,
-    // the whole grid.
+    // cells (both D passes skip the Ds beyond it): N / D is 0 wherever the smoothed N is (its
+    // Gaussian reaches rs cells), D's own Gaussian carries a change rs cells, and resolveCells'
+    // fill carries alpha kFillRings cells, so a D beyond them changes D only where alpha stays 0
+    // and no fill that reaches a covered cell reads it (two cells to spare). With
+    // LayerOptions::countEveryD, the whole grid.
     const bool countEveryD = o.countEveryD;
     auto dMargin = [countEveryD](const Layer& l) {
         return countEveryD ? l.gw + l.gh : 2 * int(std::ceil(3.f * l.sigmaCoverage)) + 2 * kFillRings + 2;
@@ -2011,11 +2012,7 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                     // it read the samples once per layer from memory. D counts whole samples: the
                     // order of the sums does not change it.
                     // A D farther than dMargin from all of the layer's cells with samples
-                    // (N > 0) changes nothing: N / D is 0 wherever the smoothed N is (its
-                    // Gaussian reaches rs cells), D's own Gaussian carries a change rs cells, and
-                    // resolveCells' fill carries alpha kFillRings cells, so such a D changes D
-                    // only where alpha stays 0 and no fill that reaches a covered cell reads it
-                    // (two cells to spare).
+                    // (N > 0) changes nothing (dMargin says why).
                     std::vector<int>& withGrid = local.withGrid;  // the layers with a motion grid, front to back
                     withGrid.clear();
                     for (int k = 0; k < nLayers; ++k)
@@ -2361,13 +2358,14 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
             }
     });
     if (stats) {
-        stats->gatheredPerPixel = double(gatheredTotal) / double(std::max<size_t>(1, size_t(W) * H));
-        stats->layersPerTile = double(layerTotal) / double(size_t(tilesX) * tilesY);
-        stats->blurredTiles = double(blurredTotal) / double(size_t(tilesX) * tilesY);
-        stats->straddlingPixels = double(straddlingTotal) / double(std::max<size_t>(1, size_t(W) * H));
-        stats->multiRayPixels = double(multiRayTotal) / double(std::max<size_t>(1, size_t(W) * H));
-        stats->raysPerPixel = double(rayTotal) / double(std::max<size_t>(1, size_t(W) * H));
-        stats->methodTiles = double(leftTotal) / double(size_t(tilesX) * tilesY);
+        const double pixels = double(std::max<size_t>(1, size_t(W) * H)), tiles = double(size_t(tilesX) * tilesY);
+        stats->gatheredPerPixel = double(gatheredTotal) / pixels;
+        stats->layersPerTile = double(layerTotal) / tiles;
+        stats->blurredTiles = double(blurredTotal) / tiles;
+        stats->straddlingPixels = double(straddlingTotal) / pixels;
+        stats->multiRayPixels = double(multiRayTotal) / pixels;
+        stats->raysPerPixel = double(rayTotal) / pixels;
+        stats->methodTiles = double(leftTotal) / tiles;
     }
     return out;
 }

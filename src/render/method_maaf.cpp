@@ -276,9 +276,7 @@ void renderMaaf(const MethodContext& ctx, RenderResult& result) {
     {
         Progress progress("maaf adaptive", extraTotal, !ctx.options.quiet && extraTotal > 0);
         std::vector<uint32_t> fill(pixels, 0);
-        // (Only in the pixels whose samples carry visibility: visibilitySamplePixels.)
-        const Image<uint8_t> keep = ctx.lightField ? visibilitySamplePixels(stats, emitterExtra) : Image<uint8_t>();
-        LightFieldStage record(ctx.lightField, [&](size_t p) { return keep[p] ? extra[p] : 0u; });
+        LightFieldStage record = adaptiveLightFieldStage(ctx, stats, emitterExtra, extra);
         result.rays += samplePixels(
             ctx.sampler, stats, view, [&](int x, int y) { return SampleRange{n0, extra(x, y)}; }, false, false,
             [&](int x, int y, const TracedSample& s, int slot) {

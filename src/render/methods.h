@@ -10,6 +10,7 @@
 #include "render/path_sampler.h"
 #include "render/pixel_stats.h"
 #include "render/renderer.h"
+#include "render/sampling.h"
 
 namespace wedge::render {
 
@@ -42,16 +43,18 @@ constexpr uint32_t kEmitterEdgeSpp = 256;
 /// reach such a rim pixel, and that light is many times the dark surface's own.
 Image<uint32_t> emitterTopUps(const PixelStatsImage& stats, uint32_t target);
 
-/// The pixels whose adaptive samples the layered reconstruction keeps (LightFieldStage), from
-/// their initial samples: where those saw more than one surface, or a surface and nothing
-/// (PixelStats::mixed), where the pixel takes emitter-edge samples (`emitterExtra`), and where
-/// they saw a surface's albedo vary (kTextureVariance: each sample carries its own albedo).
-/// Elsewhere a pixel's initial samples saw one untextured surface, and the samples aaf and maaf
-/// add there for their filters' rates carry filtered light the stage already has from them
-/// (LayerInput::surfaceLight: the light of the sample's surface in its pixel), so they would
-/// only cost the stage's time and memory. Measured on twelve scenes with motion (AAF, 512x512 or
-/// their own size, relMSE against 1024-spp MC): docs/layers.md, "The samples the stage keeps".
-Image<uint8_t> visibilitySamplePixels(const PixelStatsImage& stats, const Image<uint32_t>& emitterExtra);
+/// The light-field stage of aaf's and maaf's adaptive samples (`extra` per pixel): a pixel's are
+/// kept only where its initial samples (`stats`, before the adaptive ones) saw more than one
+/// surface, or a surface and nothing (PixelStats::mixed), where the pixel takes emitter-edge
+/// samples (`emitterExtra`), and where they saw a surface's albedo vary (kTextureVariance: each
+/// sample carries its own albedo). Elsewhere a pixel's initial samples saw one untextured
+/// surface, and the samples the filters add there for their rates carry filtered light the
+/// stage already has from them (LayerInput::surfaceLight: the light of the sample's surface in
+/// its pixel), so they would only cost the stage's time and memory. Measured on twelve scenes
+/// with motion (AAF, 512x512 or their own size, relMSE against 1024-spp MC): docs/layers.md,
+/// "The samples the stage keeps". Without ctx.lightField, a stage that records nothing.
+LightFieldStage adaptiveLightFieldStage(const MethodContext& ctx, const PixelStatsImage& stats, const Image<uint32_t>& emitterExtra,
+                                        const Image<uint32_t>& extra);
 
 /// Camera rays per pixel for the emitted light where emitterTopUps applies.
 constexpr uint32_t kEmitterEdgeRays = 1024;

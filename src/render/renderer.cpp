@@ -54,13 +54,15 @@ Image<uint32_t> emitterTopUps(const PixelStatsImage& stats, uint32_t target) {
     return extra;
 }
 
-Image<uint8_t> visibilitySamplePixels(const PixelStatsImage& stats, const Image<uint32_t>& emitterExtra) {
+LightFieldStage adaptiveLightFieldStage(const MethodContext& ctx, const PixelStatsImage& stats, const Image<uint32_t>& emitterExtra,
+                                        const Image<uint32_t>& extra) {
+    if (!ctx.lightField) return LightFieldStage(nullptr, [](size_t) { return 0u; });
     Image<uint8_t> keep(stats.width(), stats.height());
     parallelRows(stats.height(), [&](int y) {
         for (size_t p = size_t(y) * stats.width(); p < size_t(y + 1) * stats.width(); ++p)
             keep[p] = stats[p].mixed() || emitterExtra[p] > 0 || stats[p].albedoVariance() > kTextureVariance;
     });
-    return keep;
+    return LightFieldStage(ctx.lightField, [&](size_t p) { return keep[p] ? extra[p] : 0u; });
 }
 
 uint64_t denseEmission(const MethodContext& ctx, const Image<uint32_t>& topUp, FrameBuffers& fb) {
@@ -208,15 +210,6 @@ Image3f reconstructFromLayers(const MethodContext& ctx,
         lo.sharpShare = float(std::clamp(std::sqrt(perPixel / 64.0), 0.5, 1.0));
         lo.movingRays = lo.mixedRays;
     }
-    // Where aaf and maaf keep their own image in the pixels away from silhouettes
-    // (result.methodPixels), few of the pixels that trace rays do not straddle layers: there a
-    // pixel's first rays are mixedRays (64), not 32. On twelve scenes with motion (AAF, three
-    // rounds, docs/layers.md "First rays where the filters keep their own image") relMSE 0-4.5%
-    // lower (raster-motion-defocus -4.5%, bunny-motion -3.7%, conference-motion -2.3%), the
-    // stage's time unchanged at one thread (bunny-motion 1.35 s both, conference-motion 1.18 /
-    // 1.19 s); à-trous, which traces rays in every pixel of a tile with a blurred layer, paid
-    // 3-17% more stage time for it (efficiency 0.94-1.09x, 1.006x on the geometric mean).
-    if (perPixel && !result.methodPixels.empty()) lo.rays = lo.mixedRays;
     filter::LayerStats stats;
     // Where every ray of a pixel ends in sharp still layers the reconstruction is the pixel's own
     // samples, composited; the method's own composition of the pixel (`perPixel`) is the same
@@ -247,7 +240,18 @@ Image3f reconstructFromLayers(const MethodContext& ctx,
         input.surfaceAlbedo[0] = &fb.albedo;
         for (int k = 0; k < FrameBuffers::kOtherSurfaces; ++k) input.surfaceAlbedo[1 + k] = &fb.other[k].albedo;
     }
-    if (perPixel && !result.methodPixels.empty()) input.methodPixels = &result.methodPixels;
+    if (perPixel && !result.methodPixels.empty()) {
+        input.methodPixels = &result.methodPixels;
+        // Where aaf and maaf keep their own image in the pixels away from silhouettes
+        // (result.methodPixels), few of the pixels that trace rays do not straddle layers: there a
+        // pixel's first rays are mixedRays (64), not 32. On twelve scenes with motion (AAF, three
+        // rounds, docs/layers.md "First rays where the filters keep their own image") relMSE 0-4.5%
+        // lower (raster-motion-defocus -4.5%, bunny-motion -3.7%, conference-motion -2.3%), the
+        // stage's time unchanged at one thread (bunny-motion 1.35 s both, conference-motion 1.18 /
+        // 1.19 s); à-trous, which traces rays in every pixel of a tile with a blurred layer, paid
+        // 3-17% more stage time for it (efficiency 0.94-1.09x, 1.006x on the geometric mean).
+        lo.rays = lo.mixedRays;
+    }
     Image3f color = filter::reconstructLayers(input, lo, &stats, perPixel ? &own : nullptr);
     const size_t ownPixels = size_t(std::count(own.data(), own.data() + own.size(), uint8_t(1)));  // (empty without perPixel)
     parallelRows(fb.height, [&](int y) {
