@@ -616,7 +616,7 @@ TEST(Layers, TheFiltersKeepOnlyTheAdaptiveSamplesThatCarryVisibility) {
     // A lit floor filling the view under a lens focused on it, with the soft shadow of a bar
     // outside the view: every pixel's samples see one untextured surface, so the samples aaf
     // and maaf add for their filters' rates carry only light the stage has from the initial
-    // ones, and the light field keeps the initial samples alone (visibilitySamplePixels).
+    // ones, and the light field keeps the initial samples alone (adaptiveLightFieldStage).
     // With the bar in view its silhouette's pixels keep theirs.
     const std::string floor = R"({
       "camera": {"position": [0, 1, 0], "look_at": [0, 0, 0], "up": [0, 0, -1], "fov_y": 40, "resolution": [24, 24],
