@@ -1303,29 +1303,34 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
     if (own) *own = Image<uint8_t>(W, H);
     const ViewGeometry& view = in.view;
 
-    // How far each pixel's samples' trajectories reach (2 |c| + |m| from where they were taken).
-    std::vector<float> reach(size_t(W) * H, 0.f);
+    // How far each pixel's samples' trajectories reach from where they were taken, per axis: 2 |c|
+    // + |m_x| across, 2 |c| + |m_y| down. (A ray at film x_r, lens u_r and time t_r reads a
+    // layer's grid where a sample at x_s, u_s, t_s lands when x_s - x_r = c (u_r - u_s) - m (t_r -
+    // t_s), each axis apart. As one radius, 2 |c| + |m|, a camera pan's tiles gathered as far
+    // above and below as sideways: docs/layers.md, "A tile's margin per axis".)
+    std::vector<Vec2f> reach(size_t(W) * H, Vec2f{});
     // Whether a pixel's samples saw several surfaces (what the sample carries: radianceOf below).
     std::vector<uint8_t> mixed(size_t(W) * H, 0);
     parallelRows(H, [&](int y) {
         for (int x = 0; x < W; ++x) {
             const size_t p = size_t(y) * W + x;
-            float r = 0;
+            Vec2f r{};
             lf.forEach(p, [&](const LightFieldSample& s) {
                 if (s.surface() != 0) mixed[p] = 1;
                 const Vec2f m = s.motion();
-                const float c = view.defocusSlope(s.hit() ? s.depth : kInf);
-                r = std::max(r, 2.f * std::abs(c) + std::sqrt(m.x * m.x + m.y * m.y));
+                const float c = 2.f * std::abs(view.defocusSlope(s.hit() ? s.depth : kInf));
+                r = Vec2f{std::max(r.x, c + std::abs(m.x)), std::max(r.y, c + std::abs(m.y))};
             });
-            reach[p] = std::min(r, float(o.maxReach));
+            reach[p] = Vec2f{std::min(r.x, float(o.maxReach)), std::min(r.y, float(o.maxReach))};
         }
     });
     const int T = o.tile, tilesX = (W + T - 1) / T, tilesY = (H + T - 1) / T;
-    std::vector<float> tileReach(size_t(tilesX) * tilesY, 0.f);
+    std::vector<Vec2f> tileReach(size_t(tilesX) * tilesY, Vec2f{});
     for (int y = 0; y < H; ++y)
         for (int x = 0; x < W; ++x) {
-            float& r = tileReach[size_t(y / T) * tilesX + x / T];
-            r = std::max(r, reach[size_t(y) * W + x]);
+            Vec2f& r = tileReach[size_t(y / T) * tilesX + x / T];
+            const Vec2f p = reach[size_t(y) * W + x];
+            r = Vec2f{std::max(r.x, p.x), std::max(r.y, p.y)};
         }
 
     // The mean slope and inverse depth of the samples of each kSharpTextured pixel: where its
@@ -1350,21 +1355,22 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
     std::atomic<uint64_t> gatheredTotal{0}, layerTotal{0}, blurredTotal{0}, straddlingTotal{0}, leftTotal{0}, multiRayTotal{0}, rayTotal{0};
     const int apronTiles = (o.maxReach + T - 1) / T;
     const float pad = std::ceil(3.f * o.sigmaMax) + 2.f;
-    // Each tile's margin: the reach of the trajectories that can touch it, and a pad for the
-    // grids' Gaussians.
-    std::vector<int> tileMargin(size_t(tilesX) * tilesY, 0);
+    // Each tile's margin per axis: the reach of the trajectories that can touch it, and a pad
+    // for the grids' Gaussians.
+    std::vector<std::array<int, 2>> tileMargin(size_t(tilesX) * tilesY, {0, 0});
     for (int ty = 0; ty < tilesY; ++ty)
         for (int tx = 0; tx < tilesX; ++tx) {
             const int X0 = tx * T, Y0 = ty * T, X1 = std::min(W, X0 + T), Y1 = std::min(H, Y0 + T);
-            float reachT = 0;
+            Vec2f reachT{};
             for (int sy = std::max(0, ty - apronTiles); sy <= std::min(tilesY - 1, ty + apronTiles); ++sy)
                 for (int sx = std::max(0, tx - apronTiles); sx <= std::min(tilesX - 1, tx + apronTiles); ++sx) {
-                    const float r = tileReach[size_t(sy) * tilesX + sx];
+                    const Vec2f r = tileReach[size_t(sy) * tilesX + sx];
                     const int gapX = std::max({0, sx * T - X1, X0 - std::min(W, (sx + 1) * T)});
                     const int gapY = std::max({0, sy * T - Y1, Y0 - std::min(H, (sy + 1) * T)});
-                    if (float(std::max(gapX, gapY)) <= r) reachT = std::max(reachT, r);
+                    if (float(gapX) <= r.x && float(gapY) <= r.y)
+                        reachT = Vec2f{std::max(reachT.x, r.x), std::max(reachT.y, r.y)};
                 }
-            tileMargin[size_t(ty) * tilesX + tx] = int(std::ceil(reachT + pad));
+            tileMargin[size_t(ty) * tilesX + tx] = {int(std::ceil(reachT.x + pad)), int(std::ceil(reachT.y + pad))};
         }
     // The samples each tile gathers (its pixels and its margin), from sums of the counts over
     // rectangles; a thread's array is made as large as the largest tile's before its first tile.
@@ -1381,8 +1387,8 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
     }
     auto tileRegion = [&](int tx, int ty) {
         const int X0 = tx * T, Y0 = ty * T, X1 = std::min(W, X0 + T), Y1 = std::min(H, Y0 + T);
-        const int margin = tileMargin[size_t(ty) * tilesX + tx];
-        return std::array<int, 4>{std::max(0, X0 - margin), std::max(0, Y0 - margin), std::min(W, X1 + margin), std::min(H, Y1 + margin)};
+        const auto [mx, my] = tileMargin[size_t(ty) * tilesX + tx];
+        return std::array<int, 4>{std::max(0, X0 - mx), std::max(0, Y0 - my), std::min(W, X1 + mx), std::min(H, Y1 + my)};
     };
     auto regionCount = [&](const std::array<int, 4>& r) {
         const auto at = [&](int x, int y) { return countSum[size_t(y) * (W + 1) + x]; };
