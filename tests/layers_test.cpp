@@ -538,7 +538,7 @@ TEST(Layers, AMotionPastTheGridsBoundKeepsItsPixelsOwnSamples) {
     EXPECT_LT(e.squaredOn, 1.1 * e.squaredOff) << "the layers' squared error against the Monte Carlo estimate's";
 }
 
-TEST(Layers, APanGathersAlongItsMotionOnly) {
+TEST(Layers, APanGathersAlongItsMotionOnlyAndATileForItsPixelsThatTraceRays) {
     // Every sample of a 256 x 192 pinhole view moves 40 px sideways (a camera pan). A tile reads
     // the samples whose trajectories can reach it: 40 px and the grids' pad (3 sigmaMax + 2 = 8
     // px) to its left and right, only the pad above and below. (With one margin for both axes,
@@ -568,6 +568,24 @@ TEST(Layers, APanGathersAlongItsMotionOnly) {
     EXPECT_GT(stats.blurredTiles, 0.99) << "the moving layer is reprojected in every tile";
     for (int y = 0; y < H; ++y)
         for (int x = 0; x < W; ++x) ASSERT_NEAR(out(x, y).x, 0.5f, 1e-3f) << x << ", " << y;
+
+    // Every pixel but a 10 x 6 block left to the method (LayerInput::methodPixels): the one tile
+    // with rays to trace reads the samples of the block and its margins alone, not its whole
+    // tile's (with the whole tile's pixels it read 5.5x as many).
+    Image<uint8_t> left(W, H), own;
+    for (size_t p = 0; p < left.size(); ++p) left[p] = 1;
+    for (int y = 100; y < 106; ++y)
+        for (int x = 70; x < 80; ++x) left(x, y) = 0;
+    filter::LayerInput input{lf, view, {}};
+    input.methodPixels = &left;
+    const Image3f block = filter::reconstructLayers(input, o, &stats, &own);
+    const double blockRead = double(spp) * (std::min(W, 80 + 40 + pad) - std::max(0, 70 - 40 - pad)) * (106 + pad - (100 - pad));
+    EXPECT_DOUBLE_EQ(stats.gatheredPerPixel, blockRead / (W * H));
+    for (int y = 0; y < H; ++y)
+        for (int x = 0; x < W; ++x) {
+            ASSERT_EQ(own(x, y), left(x, y)) << x << ", " << y;
+            if (!left(x, y)) ASSERT_NEAR(block(x, y).x, 0.5f, 1e-3f) << x << ", " << y;
+        }
 }
 
 TEST(Layers, ASphereMovingTowardsTheCameraStaysOpaque) {

@@ -1391,10 +1391,14 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
             countSum[size_t(y + 1) * (W + 1) + x + 1] = countSum[size_t(y) * (W + 1) + x + 1] + row;
         }
     }
-    auto tileRegion = [&](int tx, int ty) {
-        const int X0 = tx * T, Y0 = ty * T, X1 = std::min(W, X0 + T), Y1 = std::min(H, Y0 + T);
+    auto tileBox = [&](int tx, int ty) {
+        return std::array<int, 4>{tx * T, ty * T, std::min(W, tx * T + T), std::min(H, ty * T + T)};
+    };
+    // The samples a tile reads for the pixels of `box` (within the tile): the box and the tile's
+    // margins.
+    auto tileRegion = [&](int tx, int ty, const std::array<int, 4>& box) {
         const auto [mx, my] = tileMargin[size_t(ty) * tilesX + tx];
-        return std::array<int, 4>{std::max(0, X0 - mx), std::max(0, Y0 - my), std::min(W, X1 + mx), std::min(H, Y1 + my)};
+        return std::array<int, 4>{std::max(0, box[0] - mx), std::max(0, box[1] - my), std::min(W, box[2] + mx), std::min(H, box[3] + my)};
     };
     auto regionCount = [&](const std::array<int, 4>& r) {
         const auto at = [&](int x, int y) { return countSum[size_t(y) * (W + 1) + x]; };
@@ -1402,7 +1406,7 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
     };
     size_t largestTile = 0;
     for (int ty = 0; ty < tilesY; ++ty)
-        for (int tx = 0; tx < tilesX; ++tx) largestTile = std::max(largestTile, regionCount(tileRegion(tx, ty)));
+        for (int tx = 0; tx < tilesX; ++tx) largestTile = std::max(largestTile, regionCount(tileRegion(tx, ty, tileBox(tx, ty))));
     // Each thread's gathered samples and split, kept across its tiles: a tile's array is tens of
     // megabytes, and allocated per tile (the tasks are single tiles) its pages were fresh every
     // time, cleared by the kernel (conference MC 512x512: 2.3% of the process in page clearing
@@ -1438,22 +1442,28 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
         Split& split = local.split;
         for (int ty = ty0; ty < ty1; ++ty)
             for (int tx = tx0; tx < tx1; ++tx) {
-                const int X0 = tx * T, Y0 = ty * T, X1 = std::min(W, X0 + T), Y1 = std::min(H, Y0 + T);
-                // The pixels left to the method (LayerInput::methodPixels); a tile of them alone
-                // is not gathered either.
+                // The pixels left to the method (LayerInput::methodPixels): own, and no ray. The
+                // tile's work is the box of the others (its grids, and the samples it gathers:
+                // a silhouette through one corner of the tile needs that corner); a tile of them
+                // alone is not gathered either. (docs/layers.md, "A tile's margin per axis".)
+                std::array<int, 4> box = tileBox(tx, ty);
                 const Image<uint8_t>* left = own ? in.methodPixels : nullptr;
                 if (left) {
-                    bool all = true;
-                    for (int y = Y0; y < Y1 && all; ++y)
-                        for (int x = X0; x < X1 && all; ++x) all = (*left)(x, y) != 0;
-                    if (all) {
-                        for (int y = Y0; y < Y1; ++y)
-                            for (int x = X0; x < X1; ++x) out(x, y) = Vec3f(0.f), (*own)(x, y) = 1;
+                    std::array<int, 4> rays{box[2], box[3], box[0], box[1]};
+                    for (int y = box[1]; y < box[3]; ++y)
+                        for (int x = box[0]; x < box[2]; ++x)
+                            if ((*left)(x, y))
+                                out(x, y) = Vec3f(0.f), (*own)(x, y) = 1;
+                            else
+                                rays = {std::min(rays[0], x), std::min(rays[1], y), std::max(rays[2], x + 1), std::max(rays[3], y + 1)};
+                    if (rays[0] >= rays[2]) {
                         ++leftTotal;
                         continue;
                     }
+                    box = rays;
                 }
-                const std::array<int, 4> region = tileRegion(tx, ty);
+                const int X0 = box[0], Y0 = box[1], X1 = box[2], Y1 = box[3];
+                const std::array<int, 4> region = tileRegion(tx, ty, box);
                 const int rx0 = region[0], ry0 = region[1], rx1 = region[2], ry1 = region[3];
                 g.clear();
                 if (g.capacity() < largestTile) g.reserve(largestTile);
