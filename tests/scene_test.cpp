@@ -4,6 +4,7 @@
 
 #include <cstring>
 #include <filesystem>
+#include <memory>
 #include <random>
 #include <tuple>
 
@@ -312,6 +313,55 @@ TEST(Scene, MotionBlurMovesGeometryOverTheShutter) {
     EXPECT_TRUE(s.intersect({0, 0, 1}, {0, 0, -1}, 0, kInf, 0.f, h));
     EXPECT_FALSE(s.intersect({0, 0, 1}, {0, 0, -1}, 0, kInf, 0.5f, h));   // quad now spans x in [0.5, 1.5]
     EXPECT_TRUE(s.intersect({1, 0, 1}, {0, 0, -1}, 0, kInf, 0.5f, h));
+}
+
+TEST(Scene, AMovingMeshBesideAStillOneIsFoundByEveryQuery) {
+    // A moving mesh is an instance of its own scene (Scene::Scene): its hits must carry its own
+    // material, object and motion through the single ray, the 16-wide packet and the stream,
+    // beside a still mesh with other ones, and find it where it is at the ray's time.
+    SceneDesc d;
+    d.materials.push_back({"a", Vec3f(0.25f), Vec3f(0.f), "", 1.f, nullptr});
+    d.materials.push_back({"b", Vec3f(0.75f), Vec3f(0.f), "", 1.f, nullptr});
+    d.lights.push_back({{-0.5f, -0.5f, 5}, {1, 0, 0}, {0, -1, 0}, Vec3f(1.f)});
+    TriangleMesh still, moving;
+    appendQuad(still, {-3.f, -0.5f, -1.f}, {2, 0, 0}, {0, 1, 0}, 0);  // x in [-3, -1], z = -1
+    appendQuad(moving, {-0.5f, -0.5f, 0.f}, {1, 0, 0}, {0, 1, 0}, 1);  // x in [-0.5, 0.5] at shutter open, z = 0
+    moving.velocity = {2, 0, 0};
+    d.meshes.push_back(still);
+    d.meshes.push_back(moving);
+    Scene s(std::move(d));
+    // (x, time, expected material or -1 for a miss)
+    const struct { float x, time; int material; } cases[] = {
+        {0.f, 0.f, 1}, {0.f, 0.5f, -1}, {1.f, 0.5f, 1}, {2.2f, 1.f, 1}, {-2.f, 0.f, 0}, {-2.f, 1.f, 0}, {-0.8f, 0.f, -1}};
+    RayPacket packet;
+    std::vector<RaySegment> stream;
+    for (int i = 0; i < int(std::size(cases)); ++i) {
+        packet.set(i, {cases[i].x, 0, 5}, {0, 0, -1}, kInf, cases[i].time);
+        stream.push_back({{cases[i].x, 0, 5}, {0, 0, -1}, kInf, cases[i].time});
+    }
+    Hit packetHits[RayPacket::kSize];
+    bool packetFound[RayPacket::kSize];
+    s.intersect(packet, packetHits, packetFound);
+    std::vector<Hit> streamHits(stream.size());
+    std::unique_ptr<bool[]> streamFound(new bool[stream.size()]);
+    s.intersect(stream.data(), stream.size(), streamHits.data(), streamFound.get());
+    for (int i = 0; i < int(std::size(cases)); ++i) {
+        SCOPED_TRACE(i);
+        Hit one;
+        const bool found = s.intersect({cases[i].x, 0, 5}, {0, 0, -1}, 0, kInf, cases[i].time, one);
+        ASSERT_EQ(found, cases[i].material >= 0);
+        ASSERT_EQ(packetFound[i], found);
+        ASSERT_EQ(streamFound[i], found);
+        if (!found) continue;
+        for (const Hit* h : {&one, &packetHits[i], &streamHits[i]}) {
+            EXPECT_EQ(int(h->material), cases[i].material);
+            EXPECT_EQ(h->albedo, Vec3f(cases[i].material == 1 ? 0.75f : 0.25f));
+            EXPECT_NEAR(h->t, cases[i].material == 1 ? 5.f : 6.f, 1e-5f);
+            EXPECT_NEAR(h->normal.z, 1.f, 1e-6f);
+            EXPECT_EQ(h->displacement, cases[i].material == 1 ? Vec3f(2, 0, 0) : Vec3f(0.f));
+        }
+        EXPECT_EQ(one.object, cases[i].material == 1 ? 1u : 0u) << "each mesh its own object";
+    }
 }
 
 TEST(Scene, TheCheckerMovesWithItsObject) {

@@ -104,6 +104,8 @@ public:
     RTCScene embree() const { return m_scene; }
 
 private:
+    /// The m_geometry entry of a hit: its instance's where it hit a moving mesh.
+    static unsigned hitGeometry(unsigned geomID, unsigned instID) { return instID != RTC_INVALID_GEOMETRY_ID ? instID : geomID; }
     /// Asks the memory for what fillHit will read of a primitive.
     void prefetchHit(unsigned geomID, unsigned primID) const;
     /// `time`: the ray's, normalised over the shutter (0 at open, 1 at close).
@@ -124,7 +126,8 @@ private:
     SceneDesc m_desc;
     RTCDevice m_device = nullptr;
     RTCScene m_scene = nullptr;
-    std::vector<GeometryInfo> m_geometry;  // by Embree geometry id
+    std::vector<GeometryInfo> m_geometry;  // by Embree geometry id in m_scene (a moving mesh: its instance's)
+    std::vector<RTCScene> m_moving;        // each moving mesh's own scene, instanced in m_scene
     std::vector<uint32_t> m_sphereMaterials;
     Vec3f m_lo{kInf}, m_hi{-kInf};
     float m_extent = 1.f;
