@@ -54,6 +54,8 @@ inline Vec3f normalize(const Vec3f& v) {
 }
 inline Vec3f vmin(const Vec3f& a, const Vec3f& b) { return {std::min(a.x, b.x), std::min(a.y, b.y), std::min(a.z, b.z)}; }
 inline Vec3f vmax(const Vec3f& a, const Vec3f& b) { return {std::max(a.x, b.x), std::max(a.y, b.y), std::max(a.z, b.z)}; }
+inline Vec2f vmin(const Vec2f& a, const Vec2f& b) { return {std::min(a.x, b.x), std::min(a.y, b.y)}; }
+inline Vec2f vmax(const Vec2f& a, const Vec2f& b) { return {std::max(a.x, b.x), std::max(a.y, b.y)}; }
 inline float maxComponent(const Vec3f& v) { return std::max(v.x, std::max(v.y, v.z)); }
 inline float luminance(const Vec3f& c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
 inline bool isFinite(const Vec3f& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }

@@ -1325,9 +1325,9 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                 if (s.surface() != 0) mixed[p] = 1;
                 const Vec2f m = s.motion();
                 const float c = 2.f * std::abs(view.defocusSlope(s.hit() ? s.depth : kInf));
-                r = Vec2f{std::max(r.x, c + std::abs(m.x)), std::max(r.y, c + std::abs(m.y))};
+                r = vmax(r, Vec2f{c + std::abs(m.x), c + std::abs(m.y)});
             });
-            reach[p] = Vec2f{std::min(r.x, float(o.maxReach)), std::min(r.y, float(o.maxReach))};
+            reach[p] = vmin(r, Vec2f{float(o.maxReach), float(o.maxReach)});
         }
     });
     const int T = o.tile, tilesX = (W + T - 1) / T, tilesY = (H + T - 1) / T;
@@ -1335,8 +1335,7 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
     for (int y = 0; y < H; ++y)
         for (int x = 0; x < W; ++x) {
             Vec2f& r = tileReach[size_t(y / T) * tilesX + x / T];
-            const Vec2f p = reach[size_t(y) * W + x];
-            r = Vec2f{std::max(r.x, p.x), std::max(r.y, p.y)};
+            r = vmax(r, reach[size_t(y) * W + x]);
         }
 
     // The mean slope and inverse depth of the samples of each kSharpTextured pixel: where its
@@ -1373,8 +1372,7 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                     const Vec2f r = tileReach[size_t(sy) * tilesX + sx];
                     const int gapX = std::max({0, sx * T - X1, X0 - std::min(W, (sx + 1) * T)});
                     const int gapY = std::max({0, sy * T - Y1, Y0 - std::min(H, (sy + 1) * T)});
-                    if (float(gapX) <= r.x && float(gapY) <= r.y)
-                        reachT = Vec2f{std::max(reachT.x, r.x), std::max(reachT.y, r.y)};
+                    if (float(gapX) <= r.x && float(gapY) <= r.y) reachT = vmax(reachT, r);
                 }
             tileMargin[size_t(ty) * tilesX + tx] = {int(std::ceil(reachT.x + pad)), int(std::ceil(reachT.y + pad))};
         }
