@@ -237,6 +237,13 @@ TEST(Cli, CoordinatesBeyondWhatEmbreeTracesAreErrors) {
                    "bad.json: objects[0]: reaches (1e+30, -0.5, -0.5) over the shutter");
     expectRejected(scene(kSphere, "\"edge1\": [1, 0, 0]", "\"edge1\": [1e20, 0, 0]"), "bad.json: lights[0]: reaches (1e+20, 2, -0.5)");
     expectRejected(scene(kSphere, "\"position\": [0, 1, 3]", "\"position\": [0, 1, 3e16]"), "bad.json: camera.position: reaches");
+    // A moving camera, at its shutter's close (the shutter is read first: its length scales it).
+    expectRejected(scene(kSphere, "\"position\": [0, 1, 3]", "\"position\": [0, 1, 3], \"velocity\": [0, 0, 1e14], \"shutter\": [0, 20]"),
+                   "bad.json: camera.velocity: reaches (0, 1, 2e+15) over the shutter");
+    expectRejected(scene(kSphere, "\"position\": [0, 1, 3]", "\"position\": [0, 1, 3], \"velocity\": [0, 1]"),
+                   "bad.json: camera.velocity: expected an array of 3 numbers");
+    expectRejected(scene(kSphere, "\"position\": [0, 1, 3]", "\"position\": [0, 1, 3], \"velocity\": [0, \"fast\", 0]"),
+                   "bad.json: camera.velocity[1]");
     std::string dir = tempDir(), err;
     writeFile(dir + "/far.json", scene(R"({"type": "sphere", "center": [0, 0, 0], "radius": 1e12, "material": "white"})"));
     EXPECT_EQ(runWedge("render " + dir + "/far.json --quiet -o " + dir + "/far.png", nullptr, &err), 0) << err;
@@ -326,6 +333,17 @@ TEST(Cli, MtlTermsThatAreNotRenderedAreNamed) {
     writeFile(dir + "/quad.mtl", "newmtl shiny\nKd 0.5 0.5 0.5\nnewmtl matte\nKd 0.4 0.4 0.4\n");
     ASSERT_EQ(runWedge("render " + dir + "/s.json --quiet -o " + dir + "/x.png", nullptr, &err), 0) << err;
     EXPECT_EQ(err.find("warning"), std::string::npos) << err;
+}
+
+TEST(Cli, RasterRefusesAMovingCamera) {
+    // wedge raster's screen motion is its triangles' own; a moving camera is wedge render's, and
+    // the rasterizer says so instead of rendering it still.
+    std::string dir = tempDir(), err;
+    writeFile(dir + "/s.json", scene(kSphere, "\"position\": [0, 1, 3]", "\"position\": [0, 1, 3], \"velocity\": [0.5, 0, 0]"));
+    EXPECT_EQ(runWedge("raster " + dir + "/s.json --quiet --spp 1 --no-reference -o " + dir + "/x.png", nullptr, &err), 2) << err;
+    EXPECT_NE(err.find("s.json: camera.velocity: wedge raster renders a still camera"), std::string::npos) << err;
+    EXPECT_FALSE(fs::exists(dir + "/x.png"));
+    EXPECT_EQ(runWedge("render " + dir + "/s.json --quiet -o " + dir + "/x.png", nullptr, &err), 0) << err;
 }
 
 TEST(Cli, RasterNamesTheMaterialsWhoseMapsItDoesNotRender) {

@@ -332,6 +332,119 @@ TEST(Render, MotionBlurIsTheShutterAverage) {
     }
 }
 
+TEST(Render, AMovingCameraIsTheSceneMovingTheOtherWay) {
+    // The camera translating by -v over the shutter sees what a still camera sees of the scene
+    // translating by +v, where the light hardly depends on where things are: a lit strip over
+    // nothing under a 200 x 200 light 64 away behind the camera. The same sample numbers make
+    // the same camera rays up to the translation, and the same light points, seen from a strip
+    // 0.6 elsewhere (measured: up to 0.1% of the strip's radiance in a pixel), with and without
+    // layers (the samples' screen motion and depth are taken from the camera where it is at each
+    // end of the shutter and at the sample's time: without the camera's part of the motion the
+    // layers' image differs by 0.12 of the strip's radiance), through a thin lens and a pinhole.
+    // Each render is also checked against the strip's shutter average (as
+    // Layers.AMovingSquareIsItsShutterAverage), so that the two cannot be wrong alike.
+    auto scene = [](const std::string& cameraVelocity, const std::string& stripVelocity, bool lens) {
+        std::string json = R"({
+          "camera": {"position": [0, 0, 0], "look_at": [0, 0, -1], "up": [0, 1, 0], "fov_y": 10, "resolution": [64, 16],
+                     LENS "velocity": [CAMERA]},
+          "materials": {"white": {"albedo": [0.8, 0.8, 0.8]}},
+          "lights": [{"type": "parallelogram", "corner": [-100, -100, 60], "edge1": [0, 200, 0], "edge2": [200, 0, 0], "radiance": [1, 1, 1]}],
+          "objects": [{"type": "quad", "corner": [-0.4, -1, -4], "edge1": [0.2, 0, 0], "edge2": [0, 2, 0], "material": "white",
+                       "velocity": [STRIP]}],
+          "render": {"spp": 64, "seed": 5, "indirect": false}
+        })";
+        json.replace(json.find("LENS"), 4, lens ? R"("aperture_radius": 0.02, "focus_distance": 3,)" : "");
+        json.replace(json.find("CAMERA"), 6, cameraVelocity);
+        json.replace(json.find("STRIP"), 5, stripVelocity);
+        return json;
+    };
+    render::RenderOptions o;
+    o.quiet = true;
+    o.method = "mc";
+    o.layers = "off";
+    const render::RenderResult still = renderJson(scene("0, 0, 0", "0, 0, 0", false), o);
+    const render::Camera cam(parse(scene("0, 0, 0", "0, 0, 0", false)).camera);
+    double radiance = 0;  // the still strip's, at its middle column
+    const int mid = int(cam.project({-0.3f, 0.f, -4.f}).x);
+    for (int y = 0; y < 16; ++y) radiance += still.color(mid, y).y / 16;
+    ASSERT_GT(radiance, 0.01);
+    for (bool lens : {false, true})
+        for (const char* layers : {"off", "on"}) {
+            o.layers = layers;
+            const std::string cameraMoves = scene("-0.6, 0, 0", "0, 0, 0", lens), stripMoves = scene("0, 0, 0", "0.6, 0, 0", lens);
+            ASSERT_TRUE(parse(cameraMoves).hasMotion());
+            const render::RenderResult a = renderJson(cameraMoves, o), b = renderJson(stripMoves, o);
+            const std::string what = std::string(lens ? "thin lens" : "pinhole") + ", layers " + layers;
+            double worst = 0;
+            for (int y = 0; y < 16; ++y)
+                for (int x = 0; x < 64; ++x) worst = std::max(worst, double(std::abs(a.color(x, y).y - b.color(x, y).y)));
+            EXPECT_LT(worst / radiance, 3e-3) << what << ": the largest difference of a pixel between the two renders";
+            // The trapezoid, from the rays through the lens centre: x on the plane z = -4, where
+            // the strip is at -0.4 .. -0.2 when the shutter opens and moves 0.6 relative to the
+            // camera. (Through the lens the rays are those of a pinhole, blurred by 0.6 px.)
+            auto covered = [&](double x) {
+                const double s0 = std::max(0.0, (x + 0.2) / 0.6), s1 = std::min(1.0, (x + 0.4) / 0.6);
+                return std::max(0.0, s1 - s0);
+            };
+            double worstColumn = 0;
+            for (int x = 0; x < 64; ++x) {
+                double measured = 0, expected = 0;
+                for (int y = 0; y < 16; ++y) measured += a.color(x, y).y / 16 / radiance;
+                for (int k = 0; k < 16; ++k) {
+                    const render::Ray ray = cam.generate(x + (k + 0.5f) / 16, 8.f, {0, 0});
+                    expected += covered(double(ray.direction.x) * -4.0 / ray.direction.z) / 16;
+                }
+                worstColumn = std::max(worstColumn, std::abs(measured - expected));
+            }
+            EXPECT_LT(worstColumn, lens ? 0.05 : 0.03) << what << ": the largest difference of a column from the trapezoid";
+        }
+}
+
+TEST(Render, AMovingCamerasSamplesMoveOnTheScreenByItsParallax) {
+    // A still wall at depth 4 and a still post at depth 2 before a pinhole that moves 0.2 to the
+    // right and 0.5 forward over the shutter. A sample's hit point P, seen from the camera at
+    // C(t) = (0.2 t, 0, -0.5 t), is at depth -P.z - 0.5 t (the depth the layers read its defocus
+    // and its place in depth from) and moves on the screen by f (P.x - 0.2) / (-P.z - 0.5) -
+    // f P.x / -P.z pixels across and the like down over the shutter (f: the focal length in
+    // pixels): the post, nearer, moves farther. Before the camera could move, a still hit had no screen motion.
+    const std::string json = R"({
+      "camera": {"position": [0, 0, 0], "look_at": [0, 0, -1], "up": [0, 1, 0], "fov_y": 20, "resolution": [32, 32],
+                 "velocity": [0.2, 0, -0.5]},
+      "materials": {"white": {"albedo": [0.8, 0.8, 0.8]}},
+      "lights": [{"type": "parallelogram", "corner": [-1, 3, -3], "edge1": [2, 0, 0], "edge2": [0, 0, 1], "radiance": [1, 1, 1]}],
+      "objects": [{"type": "quad", "corner": [-10, -10, -4], "edge1": [20, 0, 0], "edge2": [0, 20, 0], "material": "white"},
+                  {"type": "box", "min": [-0.05, -1, -2.05], "max": [0.05, 1, -1.95], "material": "white"}],
+      "render": {"spp": 16, "seed": 3, "indirect": false}
+    })";
+    const scene::SceneDesc desc = parse(json);
+    const scene::Scene sc(desc);
+    const render::Camera cam(desc.camera);
+    const render::PathSampler sampler(sc, cam, false, 3);
+    const double f = cam.focalPixels();
+    int wall = 0, post = 0;
+    double postMotion = 0, wallMotion = 0;
+    for (int x = 0; x < 32; ++x)
+        for (uint32_t k = 0; k < 16; ++k) {
+            const render::TracedSample s = sampler.trace(x, 16, k, false);
+            ASSERT_TRUE(s.hit);
+            const double px = s.position.x, pz = s.position.z, t = s.time;
+            EXPECT_NEAR(s.depth, -pz - 0.5 * t, 1e-4) << "the depth from the camera at time " << t;
+            const double motion = f * (px - 0.2) / (-pz - 0.5) - f * px / -pz;
+            EXPECT_NEAR(s.motion.x, motion, 1e-3) << "at (" << px << ", " << pz << ")";
+            // Image y grows downward; the forward motion spreads the rows apart.
+            const double py = s.position.y;
+            EXPECT_NEAR(s.motion.y, -(f * py / (-pz - 0.5) - f * py / -pz), 1e-3);
+            const bool onPost = pz > -2.1;
+            (onPost ? post : wall)++;
+            (onPost ? postMotion : wallMotion) += s.motion.x;
+        }
+    ASSERT_GT(post, 8);
+    ASSERT_GT(wall, 256);
+    // About -0.2 f / 2 against -0.2 f / 4 (the forward motion adds a little).
+    EXPECT_LT(postMotion / post, 1.7 * (wallMotion / wall));
+    EXPECT_LT(wallMotion / wall, -0.04 * f);
+}
+
 TEST(Render, ThinLensRaysMeetOnTheFocalPlane) {
     scene::CameraDesc d;
     d.position = {1, 2, 3};

@@ -10,10 +10,12 @@ Camera::Camera(const scene::CameraDesc& d)
     m_tanHalfY = std::tan(0.5f * d.fovY * kPi / 180.f);
     m_tanHalfX = m_tanHalfY * float(d.width) / float(d.height);
     m_focalPixels = 0.5f * float(d.height) / m_tanHalfY;
+    m_displacement = d.displacement();
+    m_moving = m_displacement != Vec3f(0.f);
 }
 
-Vec2f Camera::project(const Vec3f& p) const {
-    Vec3f v = p - m_position;
+Vec2f Camera::project(const Vec3f& p, float time) const {
+    Vec3f v = p - positionAt(time);
     float z = dot(v, m_forward);
     float xc = dot(v, m_right) / z, yc = dot(v, m_up) / z;
     return {(xc / m_tanHalfX + 1.f) * 0.5f * m_width, (1.f - yc / m_tanHalfY) * 0.5f * m_height};
@@ -23,7 +25,9 @@ ViewGeometry Camera::view() const {
     ViewGeometry v;
     v.width = m_width;
     v.height = m_height;
-    v.cameraPosition = m_position;
+    // A moving camera's at mid-shutter: the filters take a pixel's view direction from it and the
+    // pixel's mean hit point, which its samples at every shutter time make (filter_frames.cpp).
+    v.cameraPosition = positionAt(0.5f);
     v.forward = m_forward;
     v.right = m_right;
     v.up = m_up;

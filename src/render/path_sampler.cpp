@@ -140,12 +140,12 @@ TracedSample PathSampler::trace(int x, int y, uint32_t index, bool span) const {
     return out;
 }
 
-void PathSampler::setPrimaryHit(TracedSample& o, const scene::Hit& hit, const Vec3f& geometric) const {
+void PathSampler::setPrimaryHit(TracedSample& o, const scene::Hit& hit, const Vec3f& geometric, float time) const {
     o.hit = true;
     o.albedo = hit.albedo;
     o.normal = facing(hit.shadingNormal, geometric);
     o.position = hit.position;
-    o.depth = m_camera.depth(hit.position);
+    o.depth = m_camera.depth(hit.position, time);
     o.object = hit.object;
 }
 
@@ -176,7 +176,7 @@ void PathSampler::cameraRays(const PixelSampler& rng, int x, int y, uint32_t fir
         time[k] = uChoice[k].y;
         lens[k] = m_camera.hasLens() ? concentricDisc(uLens[k].x, uLens[k].y) : Vec2f{0, 0};
         if (film) film[k] = uPix[k];
-        Ray ray = m_camera.generate(float(x) + uPix[k].x, float(y) + uPix[k].y, lens[k]);
+        Ray ray = m_camera.generate(float(x) + uPix[k].x, float(y) + uPix[k].y, lens[k], time[k]);
         primary.set(k, ray.origin, ray.direction, kInf, time[k]);
     }
 }
@@ -290,13 +290,14 @@ void PathSampler::traceMany(const SampleRun* runs, size_t nRuns, bool span) cons
                 const bool front = dot(hit.normal, primary.dir[k]) < 0;
                 w.geometric[l] = front ? hit.normal : -hit.normal;  // two-sided shading
                 TracedSample& o = out[k];
-                setPrimaryHit(o, hit, w.geometric[l]);
+                setPrimaryHit(o, hit, w.geometric[l], w.time[l]);
                 w.normal[l] = o.normal;
-                if (lengthSquared(hit.displacement) > 0) {
-                    // The hit point's path over the shutter, through the lens centre.
+                if (lengthSquared(hit.displacement) > 0 || m_camera.moving()) {
+                    // The hit point's path over the shutter, through the lens centre (of the
+                    // camera where it is when the shutter opens and where when it closes).
                     const Vec3f& d = hit.displacement;
-                    const Vec2f open = m_camera.project(hit.position - d * w.time[l]);
-                    const Vec2f close = m_camera.project(hit.position + d * (1.f - w.time[l]));
+                    const Vec2f open = m_camera.project(hit.position - d * w.time[l], 0.f);
+                    const Vec2f close = m_camera.project(hit.position + d * (1.f - w.time[l]), 1.f);
                     o.motion = {close.x - open.x, close.y - open.y};
                 }
                 if (front) o.emission = mat.emission;  // emitters shine from their front side
@@ -426,7 +427,7 @@ uint64_t PathSampler::primaryHits(int x, int y, uint32_t first, uint32_t count, 
             o.rays = 1;
             if (!found[k]) continue;
             // As traceMany takes them, so that a texture sample finds the slot of its surface.
-            setPrimaryHit(o, hit[k], dot(hit[k].normal, primary.dir[k]) < 0 ? hit[k].normal : -hit[k].normal);
+            setPrimaryHit(o, hit[k], dot(hit[k].normal, primary.dir[k]) < 0 ? hit[k].normal : -hit[k].normal, time[k]);
         }
     }
     return count;

@@ -128,8 +128,9 @@ private:
                              float pChoice) const;
     /// The surface of a camera ray's hit into o (hit, albedo, the shading normal turned to the
     /// side of `geometric`, the geometric normal facing the ray; position, depth, object): what
-    /// PixelStats::slotOf compares, so traceMany and primaryHits must take it alike.
-    void setPrimaryHit(TracedSample& o, const scene::Hit& hit, const Vec3f& geometric) const;
+    /// PixelStats::slotOf compares, so traceMany and primaryHits must take it alike. The depth is
+    /// from the camera where it is at the sample's shutter time `time` (a moving camera).
+    void setPrimaryHit(TracedSample& o, const scene::Hit& hit, const Vec3f& geometric, float time) const;
     /// The camera rays of samples first .. first+n-1 (n <= 16) of a pixel into `primary`, with
     /// each sample's lens point, light choice and shutter time, and (unless null) the point it
     /// samples on the light, drawn with the choice and time: what traceBatch and meanEmission

@@ -48,6 +48,12 @@ struct CameraDesc {
     /// puts it when the shutter opens and moves by velocity x (close - open) until it closes.
     float shutterOpen = 0.f, shutterClose = 1.f;
     float shutterLength() const { return shutterClose - shutterOpen; }
+    /// The camera's own motion, in world units per unit of shutter time, as an object's: it is at
+    /// `position` (looking at `look_at`) when the shutter opens and translates by velocity x
+    /// (close - open) until it closes, keeping its orientation, lens and plane of focus.
+    Vec3f velocity{0.f};
+    /// Its translation over the whole shutter.
+    Vec3f displacement() const { return velocity * shutterLength(); }
 };
 
 /// An area light emitting `radiance` from the side of normalize(cross(edge1, edge2)): the
@@ -158,6 +164,7 @@ struct SceneDesc {
         for (auto& m : meshes) n += m.triangleCount();
         return n;
     }
+    /// Whether anything moves over the shutter: an object or the camera.
     bool hasMotion() const;
 };
 

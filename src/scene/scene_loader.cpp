@@ -142,6 +142,10 @@ private:
             if (std::max(std::abs(cam.shutterOpen), std::abs(cam.shutterClose)) > kMaxShutterTime)
                 s->fail("expected times within +-1e6");
         }
+        if (auto v = c.optional("velocity")) {  // (after the shutter, whose length it is scaled by)
+            cam.velocity = v->vec3();
+            checkExtent(*v, {cam.position, cam.lookAt}, cam.velocity);
+        }
         c.finish();
     }
 
