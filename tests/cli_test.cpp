@@ -240,6 +240,11 @@ TEST(Cli, CoordinatesBeyondWhatEmbreeTracesAreErrors) {
     // A moving camera, at its shutter's close (the shutter is read first: its length scales it).
     expectRejected(scene(kSphere, "\"position\": [0, 1, 3]", "\"position\": [0, 1, 3], \"velocity\": [0, 0, 1e14], \"shutter\": [0, 20]"),
                    "bad.json: camera.velocity: reaches (0, 1, 2e+15) over the shutter");
+    // A turning camera (its look_at moving) must keep a view direction that is not up's.
+    expectRejected(scene(kSphere, "\"position\": [0, 1, 3]", "\"position\": [0, 1, 3], \"look_at_velocity\": [0, 0, 3]"),
+                   "bad.json: camera.look_at_velocity: the view direction (look_at - position) turns parallel to camera.up during the shutter");
+    expectRejected(scene(kSphere, "\"position\": [0, 1, 3]", "\"position\": [0, 1, 3], \"look_at_velocity\": [0, 2, 6]"),
+                   "bad.json: camera.look_at_velocity: the view direction (look_at - position) turns to nothing during the shutter");
     expectRejected(scene(kSphere, "\"position\": [0, 1, 3]", "\"position\": [0, 1, 3], \"velocity\": [0, 1]"),
                    "bad.json: camera.velocity: expected an array of 3 numbers");
     expectRejected(scene(kSphere, "\"position\": [0, 1, 3]", "\"position\": [0, 1, 3], \"velocity\": [0, \"fast\", 0]"),
@@ -344,6 +349,9 @@ TEST(Cli, RasterRefusesAMovingCamera) {
     EXPECT_NE(err.find("s.json: camera.velocity: wedge raster renders a still camera"), std::string::npos) << err;
     EXPECT_FALSE(fs::exists(dir + "/x.png"));
     EXPECT_EQ(runWedge("render " + dir + "/s.json --quiet -o " + dir + "/x.png", nullptr, &err), 0) << err;
+    writeFile(dir + "/t.json", scene(kSphere, "\"position\": [0, 1, 3]", "\"position\": [0, 1, 3], \"look_at_velocity\": [0.5, 0, 0]"));
+    EXPECT_EQ(runWedge("raster " + dir + "/t.json --quiet --spp 1 --no-reference -o " + dir + "/y.png", nullptr, &err), 2) << err;
+    EXPECT_NE(err.find("t.json: camera.look_at_velocity: wedge raster renders a still camera"), std::string::npos) << err;
 }
 
 TEST(Cli, RasterNamesTheMaterialsWhoseMapsItDoesNotRender) {

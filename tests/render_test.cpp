@@ -445,6 +445,114 @@ TEST(Render, AMovingCamerasSamplesMoveOnTheScreenByItsParallax) {
     EXPECT_LT(wallMotion / wall, -0.04 * f);
 }
 
+TEST(Render, ATurningCamerasSamplesMoveAlikeAtEveryDepth) {
+    // A pinhole at the origin looking at (0, 0, -1), its look_at moving 0.05 to the right over
+    // the shutter: the camera turns by atan(0.05) = 2.9 degrees about its position, with
+    // forward(t) = normalize(0.05 t, 0, -1). A turn has no parallax: a wall at depth 4 and a post
+    // at depth 2 move alike on the screen, by about f tan(2.9 degrees) = 0.05 f pixels to the
+    // left. Each sample's screen motion is its point's from the camera at the shutter's open to
+    // the camera at its close, and its depth is along forward(t) at its own time.
+    const std::string json = R"({
+      "camera": {"position": [0, 0, 0], "look_at": [0, 0, -1], "up": [0, 1, 0], "fov_y": 20, "resolution": [32, 32],
+                 "look_at_velocity": [0.05, 0, 0]},
+      "materials": {"white": {"albedo": [0.8, 0.8, 0.8]}},
+      "lights": [{"type": "parallelogram", "corner": [-1, 3, -3], "edge1": [2, 0, 0], "edge2": [0, 0, 1], "radiance": [1, 1, 1]}],
+      "objects": [{"type": "quad", "corner": [-10, -10, -4], "edge1": [20, 0, 0], "edge2": [0, 20, 0], "material": "white"},
+                  {"type": "box", "min": [-0.05, -1, -2.05], "max": [0.05, 1, -1.95], "material": "white"}],
+      "render": {"spp": 16, "seed": 3, "indirect": false}
+    })";
+    const scene::SceneDesc desc = parse(json);
+    ASSERT_TRUE(desc.hasMotion());
+    const scene::Scene sc(desc);
+    const render::Camera cam(desc.camera);
+    const render::PathSampler sampler(sc, cam, false, 3);
+    const double f = cam.focalPixels();
+    // The camera's axes at time t, by hand: forward in the x-z plane, up = +y, right = forward x up.
+    auto screenX = [&](const Vec3f& p, double t) {
+        const double n = std::sqrt(0.05 * t * 0.05 * t + 1.0), fx = 0.05 * t / n, fz = -1.0 / n;
+        const double rx = -fz, rz = fx;  // (fx, 0, fz) x (0, 1, 0)
+        return f * (p.x * rx + p.z * rz) / (p.x * fx + p.z * fz);
+    };
+    auto depth = [&](const Vec3f& p, double t) {
+        const double n = std::sqrt(0.05 * t * 0.05 * t + 1.0);
+        return (p.x * 0.05 * t - p.z) / n;
+    };
+    double motion[2] = {0, 0};
+    int count[2] = {0, 0};
+    for (int x = 12; x < 20; ++x)  // near the middle, where the post is
+        for (uint32_t k = 0; k < 16; ++k) {
+            const render::TracedSample s = sampler.trace(x, 16, k, false);
+            ASSERT_TRUE(s.hit);
+            EXPECT_NEAR(s.depth, depth(s.position, s.time), 1e-4) << "the depth along forward at time " << s.time;
+            EXPECT_NEAR(s.motion.x, screenX(s.position, 1.0) - screenX(s.position, 0.0), 2e-3);
+            const int onPost = s.position.z > -2.1f;
+            motion[onPost] += s.motion.x;
+            ++count[onPost];
+        }
+    ASSERT_GT(count[0], 16);
+    ASSERT_GT(count[1], 16);
+    EXPECT_NEAR(motion[0] / count[0], -0.05 * f, 0.02 * 0.05 * f) << "the wall";
+    EXPECT_NEAR(motion[1] / count[1], motion[0] / count[0], 0.01 * 0.05 * f) << "the post, at half the wall's depth";
+}
+
+TEST(Render, ATurningCameraBlursAStripOverItsSweep) {
+    // A lit strip at depth 4 under a camera that turns as above (its look_at moving 0.1 over the
+    // shutter): a pixel's value is the strip's radiance times the share of the shutter during
+    // which its ray (the camera's at that time) meets the strip, averaged over the pixel. With
+    // and without layers (the sweep, 9.1 px, twice the strip's width), the columns' means against
+    // that share (integrated over 256 times and 16 positions in the pixel).
+    auto scene = [](const char* lookAtVelocity) {
+        std::string json = R"({
+          "camera": {"position": [0, 0, 0], "look_at": [0, 0, -1], "up": [0, 1, 0], "fov_y": 10, "resolution": [64, 16],
+                     "look_at_velocity": [LOOK]},
+          "materials": {"white": {"albedo": [0.8, 0.8, 0.8]}},
+          "lights": [{"type": "parallelogram", "corner": [-100, -100, 60], "edge1": [0, 200, 0], "edge2": [200, 0, 0], "radiance": [1, 1, 1]}],
+          "objects": [{"type": "quad", "corner": [-0.2, -1, -4], "edge1": [0.2, 0, 0], "edge2": [0, 2, 0], "material": "white"}],
+          "render": {"spp": 64, "seed": 7, "indirect": false}
+        })";
+        json.replace(json.find("LOOK"), 4, lookAtVelocity);
+        return json;
+    };
+    render::RenderOptions o;
+    o.quiet = true;
+    o.method = "mc";
+    o.layers = "off";
+    const render::RenderResult still = renderJson(scene("0, 0, 0"), o);
+    const std::string turning = scene("0.1, 0, 0");
+    const render::Camera cam(parse(turning).camera), stillCam(parse(scene("0, 0, 0")).camera);
+    double radiance = 0;
+    const int mid = int(stillCam.project({-0.1f, 0.f, -4.f}).x);
+    for (int y = 0; y < 16; ++y) radiance += still.color(mid, y).y / 16;
+    ASSERT_GT(radiance, 0.01);
+    std::vector<double> share(64, 0.0);
+    for (int x = 0; x < 64; ++x)
+        for (int k = 0; k < 16; ++k)
+            for (int i = 0; i < 256; ++i) {
+                const render::Ray ray = cam.generate(x + (k + 0.5f) / 16, 8.f, {0, 0}, (i + 0.5f) / 256);
+                const double hx = double(ray.origin.x) + double(ray.direction.x) * (-4.0 - ray.origin.z) / ray.direction.z;
+                share[x] += (hx >= -0.2 && hx <= 0.0) ? 1.0 / (16 * 256) : 0.0;
+            }
+    double total = 0;
+    int swept = 0;
+    for (double v : share) {
+        total += v;
+        swept += v > 0;
+    }
+    ASSERT_NEAR(total, 4.6, 0.1) << "the strip, 0.2 x 22.9 px per unit, lies in the view at every time";
+    ASSERT_GE(swept, 13) << "its sweep, 0.1 f = 9.1 px, too";
+    for (const char* layers : {"off", "on"}) {
+        o.layers = layers;
+        const render::RenderResult r = renderJson(turning, o);
+        double worst = 0;
+        for (int x = 0; x < 64; ++x) {
+            double measured = 0;
+            for (int y = 0; y < 16; ++y) measured += r.color(x, y).y / 16 / radiance;
+            worst = std::max(worst, std::abs(measured - share[x]));
+        }
+        EXPECT_LT(worst, 0.03) << "layers " << layers << ": the largest difference of a column from the share";
+    }
+}
+
 TEST(Render, ThinLensRaysMeetOnTheFocalPlane) {
     scene::CameraDesc d;
     d.position = {1, 2, 3};

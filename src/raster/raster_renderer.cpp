@@ -41,8 +41,9 @@ void validate(const scene::SceneDesc& desc, const RasterOptions& opt) {
         throw Error("--truth-spp " + std::to_string(opt.truthSpp), "expected 0 to 65536 samples per pixel");
     // The rasterizer's camera is still (its triangles' screen motion is their own velocity's);
     // a moving camera is `wedge render`'s.
-    if (desc.camera.velocity != Vec3f(0.f))
-        throw Error(desc.file + ": camera.velocity", "wedge raster renders a still camera; a moving one is rendered by wedge render");
+    if (desc.camera.velocity != Vec3f(0.f) || desc.camera.lookAtVelocity != Vec3f(0.f))
+        throw Error(desc.file + (desc.camera.velocity != Vec3f(0.f) ? ": camera.velocity" : ": camera.look_at_velocity"),
+                    "wedge raster renders a still camera; a moving one is rendered by wedge render");
 }
 
 /// The rasterizer's memory per visibility sample: the sample (16 bytes), its place in the

@@ -1,8 +1,12 @@
 // Thin-lens camera of the scene format: forward = normalize(look_at - position),
 // right = normalize(cross(forward, up)), image x along right, image y downward; a disc aperture
-// of radius A and a plane of focus at distance F along forward. With A = 0 it is a pinhole. A
-// moving camera (CameraDesc::velocity) translates by D = velocity x shutter length over the
-// shutter: at shutter time t in [0, 1] every ray leaves from D t further, with the same direction.
+// of radius A and a plane of focus at distance F along forward. With A = 0 it is a pinhole.
+//
+// A moving camera (CameraDesc::velocity, lookAtVelocity) is this camera at every shutter time t
+// in [0, 1], with position + D t and look_at + L t (D, L: the velocities times the shutter's
+// length) and the same `up`, field of view, lens and focus distance: a translation moves every
+// ray's origin, a moving look_at turns the camera (a pan or a tilt), and a pixel's rays at
+// time t are those of the camera at t.
 #pragma once
 
 #include "core/buffers.h"
@@ -18,27 +22,40 @@ class Camera {
 public:
     explicit Camera(const scene::CameraDesc& desc);
 
+    /// Where the camera is and how it is turned at one shutter time.
+    struct Pose {
+        Vec3f position, forward, right, up;
+    };
+
     /// The ray through film position (px, py) in pixels (0..W, 0..H) and lens point `lens` on the
     /// unit disc, at shutter time `time` in [0, 1].
     Ray generate(float px, float py, Vec2f lens, float time = 0.f) const {
+        const Pose pose = poseAt(time);
         float xc = (2.f * px / m_width - 1.f) * m_tanHalfX;
         float yc = (1.f - 2.f * py / m_height) * m_tanHalfY;
-        Vec3f dirPinhole = m_forward + m_right * xc + m_up * yc;
-        const Vec3f position = positionAt(time);
-        if (m_aperture <= 0) return {position, normalize(dirPinhole)};
+        Vec3f dirPinhole = pose.forward + pose.right * xc + pose.up * yc;
+        if (m_aperture <= 0) return {pose.position, normalize(dirPinhole)};
         // All rays through film point (xc, yc) meet on the plane of focus.
-        Vec3f focus = position + dirPinhole * m_focus;
-        Vec3f origin = position + (m_right * lens.x + m_up * lens.y) * m_aperture;
+        Vec3f focus = pose.position + dirPinhole * m_focus;
+        Vec3f origin = pose.position + (pose.right * lens.x + pose.up * lens.y) * m_aperture;
         return {origin, normalize(focus - origin)};
     }
 
     /// Image position (pixels) of a world point seen through the lens centre at shutter time t.
     Vec2f project(const Vec3f& p, float time = 0.f) const;
     /// Depth of a world point along forward, from the camera at shutter time t.
-    float depth(const Vec3f& p, float time = 0.f) const { return dot(p - positionAt(time), m_forward); }
-    /// The lens centre at shutter time t.
-    Vec3f positionAt(float time) const { return m_moving ? m_position + m_displacement * time : m_position; }
-    /// Whether the camera translates over the shutter.
+    float depth(const Vec3f& p, float time = 0.f) const {
+        const Pose pose = poseAt(time);
+        return dot(p - pose.position, pose.forward);
+    }
+    /// The camera at shutter time t (the one pose of a still camera).
+    Pose poseAt(float time) const {
+        if (!m_moving) return m_pose;
+        const Vec3f position = m_pose.position + m_displacement * time;
+        if (!m_turning) return {position, m_pose.forward, m_pose.right, m_pose.up};
+        return turned(position, m_lookAt + m_lookAtDisplacement * time);
+    }
+    /// Whether the camera moves (translates or turns) over the shutter.
     bool moving() const { return m_moving; }
 
     ViewGeometry view() const;
@@ -48,9 +65,13 @@ public:
     bool hasLens() const { return m_aperture > 0; }
 
 private:
-    Vec3f m_position, m_forward, m_right, m_up;
-    Vec3f m_displacement{0.f};  // over the whole shutter
-    bool m_moving = false;
+    /// The pose at `position` looking at `lookAt`, with the scene's up.
+    Pose turned(const Vec3f& position, const Vec3f& lookAt) const;
+
+    Pose m_pose;  // at the shutter's open
+    Vec3f m_lookAt, m_sceneUp;
+    Vec3f m_displacement{0.f}, m_lookAtDisplacement{0.f};  // over the whole shutter
+    bool m_moving = false, m_turning = false;
     int m_width, m_height;
     float m_tanHalfX, m_tanHalfY, m_focalPixels, m_aperture, m_focus;
 };

@@ -29,7 +29,7 @@ Vec3f TextureMap::lookup(Vec2f uv) const {
 }
 
 bool SceneDesc::hasMotion() const {
-    if (camera.velocity != Vec3f(0.f)) return true;  // everything moves on the screen
+    if (camera.velocity != Vec3f(0.f) || camera.lookAtVelocity != Vec3f(0.f)) return true;  // everything moves on the screen
     for (auto& m : meshes)
         if (m.velocity != Vec3f(0.f)) return true;
     for (auto& s : spheres)

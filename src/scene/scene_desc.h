@@ -49,9 +49,11 @@ struct CameraDesc {
     float shutterOpen = 0.f, shutterClose = 1.f;
     float shutterLength() const { return shutterClose - shutterOpen; }
     /// The camera's own motion, in world units per unit of shutter time, as an object's: it is at
-    /// `position` (looking at `look_at`) when the shutter opens and translates by velocity x
-    /// (close - open) until it closes, keeping its orientation, lens and plane of focus.
-    Vec3f velocity{0.f};
+    /// `position` looking at `look_at` when the shutter opens, and both move, position by
+    /// velocity and look_at by lookAtVelocity x (close - open), until it closes, with the same
+    /// up, lens and focus distance. lookAtVelocity is velocity unless the scene gives it, so
+    /// that a moving camera keeps its orientation; another turns it (a pan, a tilt).
+    Vec3f velocity{0.f}, lookAtVelocity{0.f};
     /// Its translation over the whole shutter.
     Vec3f displacement() const { return velocity * shutterLength(); }
 };

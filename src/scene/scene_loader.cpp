@@ -144,7 +144,22 @@ private:
         }
         if (auto v = c.optional("velocity")) {  // (after the shutter, whose length it is scaled by)
             cam.velocity = v->vec3();
-            checkExtent(*v, {cam.position, cam.lookAt}, cam.velocity);
+            checkExtent(*v, {cam.position}, cam.velocity);
+        }
+        cam.lookAtVelocity = cam.velocity;  // unless given: the camera keeps its orientation
+        if (auto v = c.optional("look_at_velocity")) cam.lookAtVelocity = v->vec3();
+        {
+            JsonNode where = c.optional("look_at_velocity") ? *c.optional("look_at_velocity") : c["look_at"];
+            checkExtent(where, {cam.lookAt}, cam.lookAtVelocity);
+            // The view direction a + b t over the shutter (t in [0, 1]) must not vanish or turn
+            // parallel to up: its part across up, a linear function of t, is nearest zero at t*.
+            const Vec3f up = normalize(cam.up), a = forward, b = (cam.lookAtVelocity - cam.velocity) * cam.shutterLength();
+            const Vec3f aAcross = a - up * dot(a, up), bAcross = b - up * dot(b, up);
+            const float bb = dot(bAcross, bAcross);
+            const float t = bb > 0 ? std::clamp(-dot(aAcross, bAcross) / bb, 0.f, 1.f) : 0.f;
+            if (!(length(aAcross + bAcross * t) >= 1e-6f * (length(a) + length(b))))
+                where.fail("the view direction (look_at - position) turns " +
+                           std::string(length(a + b * t) > 0 ? "parallel to camera.up" : "to nothing") + " during the shutter");
         }
         c.finish();
     }
