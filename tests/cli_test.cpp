@@ -340,6 +340,27 @@ TEST(Cli, MtlTermsThatAreNotRenderedAreNamed) {
     EXPECT_EQ(err.find("warning"), std::string::npos) << err;
 }
 
+TEST(Cli, TurningObjectsAreCheckedAsTheyTurn) {
+    // `angular_velocity` turns a mesh, quad or box about its pivot; what it cannot mean is an error.
+    const std::string box = R"({"type": "box", "min": [-0.5, 0, -0.5], "max": [0.5, 1, 0.5], "material": "white", )";
+    expectRejected(scene(R"({"type": "sphere", "center": [0, 0, 0], "radius": 0.5, "material": "white", "angular_velocity": [0, 1, 0, 90]})"),
+                   "bad.json: objects[0].angular_velocity: a sphere does not turn (meshes, quads and boxes do)");
+    expectRejected(scene(box + R"("pivot": [0, 0, 0]})"), "bad.json: objects[0].pivot: a pivot needs an angular_velocity to turn about it");
+    expectRejected(scene(box + R"("angular_velocity": [0, 0, 0, 90]})"), "bad.json: objects[0].angular_velocity: the axis must be non-zero");
+    expectRejected(scene(box + R"("angular_velocity": [0, 1, 0]})"),
+                   "bad.json: objects[0].angular_velocity: expected [axis_x, axis_y, axis_z, degrees per unit of shutter time]");
+    expectRejected(scene(box + R"("angular_velocity": [0, 1, 0, "fast"]})"), "bad.json: objects[0].angular_velocity[3]");
+    // About a pivot far away the box sweeps a sphere of that radius.
+    expectRejected(scene(box + R"("angular_velocity": [0, 1, 0, 10], "pivot": [1e16, 0, 0]})"), "bad.json: objects[0].pivot: reaches");
+    std::string dir = tempDir(), err;
+    writeFile(dir + "/turn.json", scene(box + R"("angular_velocity": [0, 1, 0, 30]})"));
+    EXPECT_EQ(runWedge("render " + dir + "/turn.json --quiet -o " + dir + "/x.png", nullptr, &err), 0) << err;
+    // wedge raster moves its triangles by translation alone, and says so.
+    EXPECT_EQ(runWedge("raster " + dir + "/turn.json --quiet --spp 1 --no-reference -o " + dir + "/y.png", nullptr, &err), 2) << err;
+    EXPECT_NE(err.find("turn.json: box[0]: angular_velocity: wedge raster moves objects by translation alone"), std::string::npos) << err;
+    EXPECT_FALSE(fs::exists(dir + "/y.png"));
+}
+
 TEST(Cli, RasterRefusesAMovingCamera) {
     // wedge raster's screen motion is its triangles' own; a moving camera is wedge render's, and
     // the rasterizer says so instead of rendering it still.

@@ -553,6 +553,87 @@ TEST(Render, ATurningCameraBlursAStripOverItsSweep) {
     }
 }
 
+namespace {
+
+/// A lit bar 1 x 0.08 at depth 4 before a pinhole (fov 20 degrees, 64 x 64), turning by
+/// `degrees` about the view axis through its centre over the shutter, rendered by MC at `spp`
+/// with `layers`, against the share of the shutter each pixel sees it (the bar turned at 256
+/// times, 4 x 4 points a pixel, the pixel's point on the plane from the field of view alone),
+/// times the still bar's radiance. Returns the mean absolute difference over the pixels and the
+/// largest over 8 x 8 blocks, in the bar's radiance.
+std::pair<double, double> turningBarErrors(float degrees, int spp, const char* layers) {
+    auto scene = [](float d) {
+        std::string json = R"({
+          "camera": {"position": [0, 0, 0], "look_at": [0, 0, -1], "up": [0, 1, 0], "fov_y": 20, "resolution": [64, 64]},
+          "materials": {"white": {"albedo": [0.8, 0.8, 0.8]}},
+          "lights": [{"type": "parallelogram", "corner": [-100, -100, 60], "edge1": [0, 200, 0], "edge2": [200, 0, 0], "radiance": [1, 1, 1]}],
+          "objects": [{"type": "quad", "corner": [-0.5, -0.04, -4], "edge1": [1, 0, 0], "edge2": [0, 0.08, 0], "material": "white",
+                       "angular_velocity": [0, 0, 1, DEGREES]}],
+          "render": {"spp": 16, "seed": 9, "indirect": false}
+        })";
+        json.replace(json.find("DEGREES"), 7, std::to_string(d));
+        return json;
+    };
+    render::RenderOptions o;
+    o.quiet = true;
+    o.method = "mc";
+    o.spp = 64;
+    o.layers = "off";
+    const render::RenderResult still = renderJson(scene(0.f), o);
+    double radiance = 0;
+    for (int y = 31; y < 33; ++y)
+        for (int x = 16; x < 48; ++x) radiance += still.color(x, y).y / 64;
+    EXPECT_GT(radiance, 0.01);
+    o.spp = spp;
+    o.layers = layers;
+    const render::RenderResult r = renderJson(scene(degrees), o);
+    const double half = 4.0 * std::tan(10.0 * kPi / 180.0);  // the plane's half-width seen
+    double sum = 0, worstBlock = 0;
+    std::vector<double> diff(64 * 64);
+    for (int y = 0; y < 64; ++y)
+        for (int x = 0; x < 64; ++x) {
+            double share = 0;
+            for (int k = 0; k < 16; ++k) {
+                const double px = (x + (k % 4 + 0.5) / 4) / 32.0 - 1.0, py = 1.0 - (y + (k / 4 + 0.5) / 4) / 32.0;
+                const double X = px * half, Y = py * half;
+                for (int i = 0; i < 256; ++i) {
+                    const double a = -degrees * kPi / 180.0 * (i + 0.5) / 256;  // the bar's frame at that time
+                    const double bx = X * std::cos(a) - Y * std::sin(a), by = X * std::sin(a) + Y * std::cos(a);
+                    share += (std::abs(bx) <= 0.5 && std::abs(by) <= 0.04) ? 1.0 / (16 * 256) : 0.0;
+                }
+            }
+            diff[size_t(y) * 64 + x] = r.color(x, y).y / radiance - share;
+            sum += std::abs(diff[size_t(y) * 64 + x]);
+        }
+    for (int by = 0; by < 64; by += 8)
+        for (int bx = 0; bx < 64; bx += 8) {
+            double block = 0;
+            for (int y = by; y < by + 8; ++y)
+                for (int x = bx; x < bx + 8; ++x) block += diff[size_t(y) * 64 + x] / 64;
+            worstBlock = std::max(worstBlock, std::abs(block));
+        }
+    return {sum / (64 * 64), worstBlock};
+}
+
+}  // namespace
+
+TEST(Render, ATurningBarSweepsItsShareOfTheShutter) {
+    // Geometry and time: 64 samples a pixel without layers, a 40-degree turn (Embree's
+    // quaternion steps, every sample at its own time).
+    const auto [mean, block] = turningBarErrors(40.f, 64, "off");
+    EXPECT_LT(mean, 0.01) << "the mean absolute difference of a pixel (measured 0.0045)";
+    EXPECT_LT(block, 0.02) << "the largest of an 8 x 8 block's mean (0.011: 64 x 64 samples' noise)";
+    // At 16 samples a pixel the layers reconstruct the turn from the samples around: each is
+    // reprojected along the chord of its arc (a straight motion over the shutter), following the
+    // motion its layer's grid finds. Measured: 0.0062 a pixel against 0.0133 without layers.
+    // (With a layer judged sharp by its mean motion, near nothing for a turn about its middle,
+    // the layers left every sample where it was taken: the same 0.0133.)
+    const auto [meanOn, blockOn] = turningBarErrors(40.f, 16, "on");
+    const auto [meanOff, blockOff] = turningBarErrors(40.f, 16, "off");
+    EXPECT_LT(meanOn, 0.6 * meanOff);
+    EXPECT_LT(blockOn, 0.06) << "the chord's bias (0.043), within a block";
+}
+
 TEST(Render, ThinLensRaysMeetOnTheFocalPlane) {
     scene::CameraDesc d;
     d.position = {1, 2, 3};

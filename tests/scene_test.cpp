@@ -358,9 +358,51 @@ TEST(Scene, AMovingMeshBesideAStillOneIsFoundByEveryQuery) {
             EXPECT_EQ(h->albedo, Vec3f(cases[i].material == 1 ? 0.75f : 0.25f));
             EXPECT_NEAR(h->t, cases[i].material == 1 ? 5.f : 6.f, 1e-5f);
             EXPECT_NEAR(h->normal.z, 1.f, 1e-6f);
-            EXPECT_EQ(h->displacement, cases[i].material == 1 ? Vec3f(2, 0, 0) : Vec3f(0.f));
+            EXPECT_EQ(h->motion ? h->motion->displacement : Vec3f(0.f), cases[i].material == 1 ? Vec3f(2, 0, 0) : Vec3f(0.f));
         }
         EXPECT_EQ(one.object, cases[i].material == 1 ? 1u : 0u) << "each mesh its own object";
+    }
+}
+
+TEST(Scene, ATurningMeshIsWhereItsRotationPutsIt) {
+    // A 2 x 2 quad in the plane z = 0 (front +z) turning about the y axis through its centre
+    // (`angular_velocity`, the pivot at its box's centre) by 90 degrees, and another by 360,
+    // over the shutter. At time t the quad's plane has the normal n = (sin a, 0, cos a), a = the
+    // angle turned, so a ray from (0.5, 0, 5) down -z meets it at z = -0.5 tan a (within the
+    // quad while a < 60 degrees, or near a half turn): its distance, its normal (turned with
+    // the quad: Embree gives an instance's Ng in the instanced scene's space) and the point of
+    // the quad at shutter open it hit (RigidMotion::atOpen: on z = 0 at x = 0.5 / cos a). The
+    // full turn's half (180 degrees) is past a slerp's shorter way between two time steps, which
+    // would have left the quad unturned: the steps are at most a quarter turn apart.
+    for (float degrees : {90.f, 360.f}) {
+        SceneDesc d;
+        d.materials.push_back({"white", Vec3f(0.5f), Vec3f(0.f), "", 1.f, nullptr});
+        d.lights.push_back({{-0.5f, 5, -0.5f}, {1, 0, 0}, {0, 0, 1}, Vec3f(1.f)});
+        TriangleMesh m;
+        appendQuad(m, {-1, -1, 0}, {2, 0, 0}, {0, 2, 0}, 0);
+        m.turnAxis = {0, 1, 0};
+        m.turnDegrees = degrees;
+        m.pivot = {0, 0, 0};
+        d.meshes.push_back(m);
+        ASSERT_TRUE(d.hasMotion());
+        Scene s(std::move(d));
+        for (float t : {0.f, 0.1f, 0.25f, 0.5f}) {
+            const double a = double(degrees) * t * kPi / 180.0;
+            if (std::abs(std::tan(a)) > 1.5) continue;  // the ray misses the quad's edge-on passage
+            SCOPED_TRACE(std::to_string(degrees) + " degrees at t = " + std::to_string(t));
+            Hit h;
+            ASSERT_TRUE(s.intersect({0.5f, 0, 5}, {0, 0, -1}, 0, kInf, t, h));
+            EXPECT_NEAR(h.t, 5.0 + 0.5 * std::tan(a), 1e-4);
+            EXPECT_NEAR(h.normal.x, std::sin(a), 1e-4);
+            EXPECT_NEAR(h.normal.z, std::cos(a), 1e-4);
+            EXPECT_NEAR(h.shadingNormal.x, std::sin(a), 1e-4);
+            ASSERT_NE(h.motion, nullptr);
+            const Vec3f open = h.motion->atOpen(h.position, t);
+            EXPECT_NEAR(open.z, 0.f, 1e-4f);
+            EXPECT_NEAR(open.x, 0.5 / std::abs(std::cos(a)) * (std::cos(a) > 0 ? 1 : -1), 1e-4);
+            const Vec3f back = h.motion->at(open, t);
+            EXPECT_NEAR(length(back - h.position), 0.f, 1e-4f) << "at() undoes atOpen()";
+        }
     }
 }
 
@@ -388,6 +430,42 @@ TEST(Scene, TheCheckerMovesWithItsObject) {
     EXPECT_EQ(albedoAt(0.25f + 0.75f, 0.25f, 0.5f), light) << "the same point of the quad, moved 0.75";
     EXPECT_EQ(albedoAt(1.25f + 1.5f, 0.25f, 1.f), dark);
     EXPECT_EQ(albedoAt(1.25f, 0.25f, 0.5f), light) << "a fixed point of space sees the quad slide under it";
+}
+
+TEST(Scene, TheCheckerTurnsWithItsObject) {
+    // The same checkered quad turning 90 degrees about the view axis through the origin (and
+    // moving 1 along y) over the shutter: the point a ray meets at time t is the quad's point
+    // at shutter open turned by 90 t degrees and moved by t, and shows that point's cell.
+    SceneDesc d;
+    d.materials.push_back({"c", Vec3f(0.5f), Vec3f(0.f), "checker", 1.f, nullptr});
+    d.lights.push_back({{-0.5f, -0.5f, 5}, {1, 0, 0}, {0, -1, 0}, Vec3f(1.f)});
+    TriangleMesh m;
+    appendQuad(m, {-4, -4, 0}, {8, 0, 0}, {0, 8, 0}, 0);
+    m.velocity = {0, 1, 0};
+    m.turnAxis = {0, 0, 1};
+    m.turnDegrees = 90.f;
+    m.pivot = {0, 0, 0};
+    d.meshes.push_back(m);
+    Scene s(std::move(d));
+    auto albedoAt = [&](Vec2f p, float t) {
+        Hit h;
+        EXPECT_TRUE(s.intersect({p.x, p.y, 1}, {0, 0, -1}, 0, kInf, t, h));
+        return h.albedo;
+    };
+    int dark = 0, checked = 0;
+    for (float t : {0.25f, 0.5f, 0.8f})
+        for (int i = 0; i < 13; ++i)
+            for (int j = 0; j < 13; ++j) {
+                const float x = -1.85f + 0.3f * float(i), y = -1.85f + 0.3f * float(j);  // 0.05 or more from a cell's edge
+                const float a = 0.5f * kPi * t;  // where the quad's point (x, y) is at time t
+                const Vec2f moved{x * std::cos(a) - y * std::sin(a), x * std::sin(a) + y * std::cos(a) + t};
+                const Vec3f open = albedoAt({x, y}, 0.f);
+                EXPECT_EQ(albedoAt(moved, t), open) << "(" << x << ", " << y << ") at t = " << t;
+                dark += open.x < 0.4f;
+                ++checked;
+            }
+    EXPECT_GT(dark, checked / 4) << "both cells are among the points";
+    EXPECT_LT(dark, 3 * checked / 4);
 }
 
 TEST(Scene, CornerNormalsAreInterpolatedWithEmbreeBarycentrics) {

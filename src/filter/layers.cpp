@@ -242,7 +242,7 @@ void summedArea(int gw, int gh, std::vector<int>& sat, Has&& has) {
 }
 
 struct Layer {
-    double sumC = 0, sumMx = 0, sumMy = 0, sumInvDepth = 0;
+    double sumC = 0, sumMx = 0, sumMy = 0, sumM2 = 0, sumInvDepth = 0;  // sumM2: of |motion|^2
     float cMin = kInf, cMax = -kInf;
     float invDepthMax = 0;  // of its nearest sample (0: a miss)
     float invDepthMin = kInf;  // of its farthest
@@ -254,6 +254,11 @@ struct Layer {
     bool inFrontOfAll(float q, float t) const { return moving && inFrontOfMoving(invDepthMax, depthRate, q, t); }
     // The shear y = x + c u - m (t - 1/2) (film y: y - c v - m_y (t - 1/2)) and the sharp image's filter.
     float c = 0, mx = 0, my = 0, invDepth = 0;
+    // The root mean square of its samples' screen motion: its mean's length where they move
+    // alike, more where they do not (an object turning about a point of it moves one way on one
+    // side and the other way on the other, its mean motion near nothing: judged by the mean, its
+    // layer was sharp and its samples stayed where they were taken).
+    float motionRms = 0;
     // The rays' shear, shaped by the grid's own blur (Shaped): a ray at lens point u (unit disc)
     // is sheared by (rayC + rayC2 |u|^2) u, one at time t by (1 + rayT2 (2 s)^2) s rayM, s = t -
     // 1/2. A ray that takes the slope c of the surface it finds is sheared by (A(c) + B(c)
@@ -357,7 +362,7 @@ struct Split {
         float cHi = 0, binW = 1;
         int bins = 0, base = 0;
         std::vector<int> count, binLayer;
-        std::vector<double> sumC, sumMx, sumMy, sumInvDepth;
+        std::vector<double> sumC, sumMx, sumMy, sumM2, sumInvDepth;
         std::vector<float> cMin, cMax, invMax, invMin;
         std::vector<uint8_t> sharpRun;  // per layer of the class: a merged run of sharp layers
         float invBinW = 0;  // 1 / binW where that is exact (binW a power of two, as the least, 0.25, is), else 0
@@ -379,6 +384,7 @@ void addBin(Layer& l, const Split::Histogram& h, int b) {
     l.sumC += h.sumC[b];
     l.sumMx += h.sumMx[b];
     l.sumMy += h.sumMy[b];
+    l.sumM2 += h.sumM2[b];
     l.sumInvDepth += h.sumInvDepth[b];
     l.cMin = std::min(l.cMin, h.cMin[b]);
     l.cMax = std::max(l.cMax, h.cMax[b]);
@@ -713,7 +719,7 @@ void splitLayers(Samples& g, const SlopeRange (&range)[kClasses], const float (&
         h.bins = int((r.hi - r.lo) / h.binW) + 1;
         h.count.assign(h.bins, 0);
         h.binLayer.assign(h.bins, -1);
-        for (auto* v : {&h.sumC, &h.sumMx, &h.sumMy, &h.sumInvDepth}) v->assign(h.bins, 0.0);
+        for (auto* v : {&h.sumC, &h.sumMx, &h.sumMy, &h.sumM2, &h.sumInvDepth}) v->assign(h.bins, 0.0);
         h.cMin.assign(h.bins, kInf);
         h.cMax.assign(h.bins, -kInf);
         h.invMax.assign(h.bins, 0.f);
@@ -724,7 +730,7 @@ void splitLayers(Samples& g, const SlopeRange (&range)[kClasses], const float (&
     // the bin changes (summing into the bin sample by sample chained every add through memory).
     struct Run {
         int bin = -1, count = 0;
-        double c = 0, mx = 0, my = 0, invDepth = 0;
+        double c = 0, mx = 0, my = 0, m2 = 0, invDepth = 0;
         float cMin = kInf, cMax = -kInf, invMax = 0, invMin = kInf;
     };
     Run run[kClasses];
@@ -736,6 +742,7 @@ void splitLayers(Samples& g, const SlopeRange (&range)[kClasses], const float (&
         h.sumC[r.bin] += r.c;
         h.sumMx[r.bin] += r.mx;
         h.sumMy[r.bin] += r.my;
+        h.sumM2[r.bin] += r.m2;
         h.sumInvDepth[r.bin] += r.invDepth;
         h.cMin[r.bin] = std::min(h.cMin[r.bin], r.cMin);
         h.cMax[r.bin] = std::max(h.cMax[r.bin], r.cMax);
@@ -759,6 +766,7 @@ void splitLayers(Samples& g, const SlopeRange (&range)[kClasses], const float (&
             r.c += s.c;
             r.mx += s.mx;
             r.my += s.my;
+            r.m2 += s.mx * s.mx + s.my * s.my;
             r.invDepth += s.invDepth;
             r.cMin = std::min(r.cMin, s.c);
             r.cMax = std::max(r.cMax, s.c);
@@ -815,6 +823,7 @@ void splitLayers(Samples& g, const SlopeRange (&range)[kClasses], const float (&
         l.c = float(l.sumC * inv);
         l.mx = float(l.sumMx * inv);
         l.my = float(l.sumMy * inv);
+        l.motionRms = float(std::sqrt(l.sumM2 * inv));
         l.invDepth = float(l.sumInvDepth * inv);
     }
     // Front to back: by mean inverse depth (a miss is at 0), which orders layers of any slope; a
@@ -1779,7 +1788,7 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                 bool anyBlurred = false;
                 for (Layer& l : layers) {
                     const float spread = l.cMax - l.cMin;
-                    const float motion = std::sqrt(l.mx * l.mx + l.my * l.my);
+                    const float motion = l.motionRms;
                     // The grid blurs by its own kernel too: the cells a sample is splatted into
                     // (variance 1/12 per axis), the Gaussian (sigma^2) and the bilinear lookup
                     // (1/6). The rays' lens and shutter shear is shaped (Shaped) so that with

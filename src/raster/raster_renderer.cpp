@@ -44,6 +44,11 @@ void validate(const scene::SceneDesc& desc, const RasterOptions& opt) {
     if (desc.camera.velocity != Vec3f(0.f) || desc.camera.lookAtVelocity != Vec3f(0.f))
         throw Error(desc.file + (desc.camera.velocity != Vec3f(0.f) ? ": camera.velocity" : ": camera.look_at_velocity"),
                     "wedge raster renders a still camera; a moving one is rendered by wedge render");
+    // Likewise its triangles translate and do not turn.
+    for (const scene::TriangleMesh& m : desc.meshes)
+        if (m.turnDegrees != 0)
+            throw Error(desc.file + ": " + m.name + ": angular_velocity",
+                        "wedge raster moves objects by translation alone; a turning one is rendered by wedge render");
 }
 
 /// The rasterizer's memory per visibility sample: the sample (16 bytes), its place in the

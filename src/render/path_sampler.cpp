@@ -292,12 +292,18 @@ void PathSampler::traceMany(const SampleRun* runs, size_t nRuns, bool span) cons
                 TracedSample& o = out[k];
                 setPrimaryHit(o, hit, w.geometric[l], w.time[l]);
                 w.normal[l] = o.normal;
-                if (lengthSquared(hit.displacement) > 0 || m_camera.moving()) {
+                if (hit.motion || m_camera.moving()) {
                     // The hit point's path over the shutter, through the lens centre (of the
-                    // camera where it is when the shutter opens and where when it closes).
-                    const Vec3f& d = hit.displacement;
-                    const Vec2f open = m_camera.project(hit.position - d * w.time[l], 0.f);
-                    const Vec2f close = m_camera.project(hit.position + d * (1.f - w.time[l]), 1.f);
+                    // camera where it is when the shutter opens and where when it closes): from
+                    // where the point is at the open to where at the close, a chord of its arc
+                    // where the object turns.
+                    const float t = w.time[l];
+                    const scene::RigidMotion* m = hit.motion;
+                    const Vec3f atOpen = m ? m->atOpen(hit.position, t) : hit.position;
+                    const Vec3f atClose = !m ? hit.position
+                                          : m->turns() ? m->at(atOpen, 1.f)
+                                                       : hit.position + m->displacement * (1.f - t);
+                    const Vec2f open = m_camera.project(atOpen, 0.f), close = m_camera.project(atClose, 1.f);
                     o.motion = {close.x - open.x, close.y - open.y};
                 }
                 if (front) o.emission = mat.emission;  // emitters shine from their front side

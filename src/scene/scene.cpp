@@ -47,8 +47,10 @@ Scene::Scene(SceneDesc desc) : m_desc(std::move(desc)) {
     const float shutter = m_desc.camera.shutterLength();
     uint32_t object = 0;
     for (const TriangleMesh& mesh : m_desc.meshes) {
-        bool moving = mesh.velocity != Vec3f(0.f);
-        const Vec3f displacement = mesh.velocity * shutter;
+        const RigidMotion motion = mesh.motion(shutter);
+        const bool moving = motion.moves();
+        const Vec3f displacement = motion.displacement;
+        float reach = 0;  // a turning mesh's farthest point from its pivot
         // A moving mesh translates rigidly: it is its own scene, built once at shutter open with
         // the scene's quality, and instanced with a transform per time step. (As a triangle mesh
         // with two vertex time steps it took Embree's motion-blur BVH, at medium quality: the
@@ -64,7 +66,13 @@ Scene::Scene(SceneDesc desc) : m_desc(std::move(desc)) {
                 v[3 * i] = p.x; v[3 * i + 1] = p.y; v[3 * i + 2] = p.z;
                 m_lo = vmin(m_lo, vmin(p, p + displacement));
                 m_hi = vmax(m_hi, vmax(p, p + displacement));
+                if (motion.turns()) reach = std::max(reach, length(p - motion.pivot));
             }
+            if (motion.turns())  // every point stays within `reach` of the moving pivot
+                for (const Vec3f& c : {motion.pivot, motion.pivot + displacement}) {
+                    m_lo = vmin(m_lo, c - Vec3f(reach));
+                    m_hi = vmax(m_hi, c + Vec3f(reach));
+                }
         }
         auto* idx = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
                                                                    3 * sizeof(uint32_t), mesh.triangleCount()));
@@ -79,11 +87,30 @@ Scene::Scene(SceneDesc desc) : m_desc(std::move(desc)) {
             m_moving.push_back(own);
             RTCGeometry instance = rtcNewGeometry(m_device, RTC_GEOMETRY_TYPE_INSTANCE);
             rtcSetGeometryInstancedScene(instance, own);
-            rtcSetGeometryTimeStepCount(instance, 2);
-            for (unsigned step = 0; step < 2; ++step) {
-                const Vec3f d = displacement * float(step);
-                const float xfm[12] = {1, 0, 0, 0, 1, 0, 0, 0, 1, d.x, d.y, d.z};  // 3x4, column-major
-                rtcSetGeometryTransform(instance, step, RTC_FORMAT_FLOAT3X4_COLUMN_MAJOR, xfm);
+            if (!motion.turns()) {
+                rtcSetGeometryTimeStepCount(instance, 2);
+                for (unsigned step = 0; step < 2; ++step) {
+                    const Vec3f d = displacement * float(step);
+                    const float xfm[12] = {1, 0, 0, 0, 1, 0, 0, 0, 1, d.x, d.y, d.z};  // 3x4, column-major
+                    rtcSetGeometryTransform(instance, step, RTC_FORMAT_FLOAT3X4_COLUMN_MAJOR, xfm);
+                }
+            } else {
+                // A turn: quaternion decompositions, which Embree interpolates with a slerp of the
+                // rotation (a matrix interpolated linearly would shrink the object between the
+                // steps), p -> R (p - pivot) + pivot + d t. The slerp takes the shorter way, so the
+                // steps are at most a quarter turn apart.
+                const unsigned steps = 2 + unsigned(std::abs(motion.radians) / (0.5f * kPi));
+                rtcSetGeometryTimeStepCount(instance, steps);
+                for (unsigned step = 0; step < steps; ++step) {
+                    const float t = float(step) / float(steps - 1), half = 0.5f * motion.radians * t;
+                    const Vec3f q = motion.axis * std::sin(half), at = motion.pivot + displacement * t;
+                    RTCQuaternionDecomposition xfm;
+                    rtcInitQuaternionDecomposition(&xfm);
+                    rtcQuaternionDecompositionSetShift(&xfm, -motion.pivot.x, -motion.pivot.y, -motion.pivot.z);
+                    rtcQuaternionDecompositionSetQuaternion(&xfm, std::cos(half), q.x, q.y, q.z);
+                    rtcQuaternionDecompositionSetTranslation(&xfm, at.x, at.y, at.z);
+                    rtcSetGeometryTransformQuaternion(instance, step, &xfm);
+                }
             }
             rtcCommitGeometry(instance);
             id = rtcAttachGeometry(m_scene, instance);
@@ -95,7 +122,7 @@ Scene::Scene(SceneDesc desc) : m_desc(std::move(desc)) {
         if (m_geometry.size() <= id) m_geometry.resize(id + 1);
         m_geometry[id] = {mesh.materialIds.data(), mesh.shapeIds.data(), 0, object, false,
                           mesh.cornerNormals.size() == mesh.indices.size() ? mesh.cornerNormals.data() : nullptr,
-                          displacement,
+                          motion,
                           mesh.cornerUVs.size() == mesh.indices.size() ? mesh.cornerUVs.data() : nullptr};
         uint32_t shapes = 0;
         for (uint32_t sId : mesh.shapeIds) shapes = std::max(shapes, sId + 1);
@@ -123,6 +150,8 @@ Scene::Scene(SceneDesc desc) : m_desc(std::move(desc)) {
         unsigned id = rtcAttachGeometry(m_scene, geom);
         rtcReleaseGeometry(geom);
         for (auto& s : m_desc.spheres) m_sphereMaterials.push_back(s.material);
+        if (moving)
+            for (auto& s : m_desc.spheres) m_sphereMotion.push_back({s.velocity * shutter});
         if (m_geometry.size() <= id) m_geometry.resize(id + 1);
         m_geometry[id] = {m_sphereMaterials.data(), nullptr, 0, object, true};
         object += uint32_t(m_desc.spheres.size());
@@ -145,19 +174,25 @@ void Scene::fillHit(const Vec3f& org, const Vec3f& dir, float t, float time, uns
     hit.position = org + dir * t;
     // Embree's Ng is the counter-clockwise normal for triangles and points outward for spheres
     // (tests/scene_test.cpp checks both), which is our front side.
-    hit.normal = normalize(ng);
+    // The object that moves, if it does (null: still). A turning mesh's normals are its own at
+    // shutter open (Embree gives an instance's Ng in the instanced scene's space), turned with it.
+    const RigidMotion* motion = g.sphere ? (m_sphereMotion.empty() ? nullptr : &m_sphereMotion[primID])
+                                         : (g.motion.moves() ? &g.motion : nullptr);
+    hit.motion = motion && motion->moves() ? motion : nullptr;
+    const bool turns = hit.motion && hit.motion->turns();
+    hit.normal = normalize(turns ? hit.motion->turn(ng, time) : ng);
     hit.shadingNormal = hit.normal;
     if (g.cornerNormals) {
         // Embree's barycentrics: p = (1 - u - v) p0 + u p1 + v p2.
         const Vec3f* n = g.cornerNormals + 3 * size_t(primID);
         Vec3f s = n[0] * (1.f - u - v) + n[1] * u + n[2] * v;
+        if (turns) s = hit.motion->turn(s, time);
         float len = length(s);
         if (len > 0) hit.shadingNormal = s / len;
     }
     hit.material = g.materialIds ? g.materialIds[primID] : g.material;
     // Spheres: one surface each; meshes: one per shape.
     hit.object = g.object + (g.sphere ? primID : (g.shapeIds ? g.shapeIds[primID] : 0));
-    hit.displacement = g.sphere ? m_desc.spheres[primID].velocity * m_desc.camera.shutterLength() : g.displacement;
     const Material& m = m_desc.materials[hit.material];
     if (m.map && g.cornerUVs) {
         const Vec2f* uv = g.cornerUVs + 3 * size_t(primID);
@@ -166,8 +201,10 @@ void Scene::fillHit(const Vec3f& org, const Vec3f& dir, float t, float time, uns
     } else if (m.texture.empty()) {
         hit.albedo = m.albedo;
     } else {
-        // The texture is attached to the object: look it up where the point was at shutter open.
-        hit.albedo = albedoAt(m, hit.position - hit.displacement * time, hit.normal);
+        // The texture is attached to the object: look it up where the point was at shutter open
+        // (with the normal it had then, which picks the checker's plane).
+        hit.albedo = hit.motion ? albedoAt(m, hit.motion->atOpen(hit.position, time), turns ? hit.motion->turn(hit.normal, -time) : hit.normal)
+                                : albedoAt(m, hit.position, hit.normal);
     }
 }
 

@@ -21,7 +21,7 @@ struct Hit {
     uint32_t material = 0;
     uint32_t object = 0;  // surface id: one per mesh shape (OBJ group) or primitive, one per sphere
     Vec3f albedo;         // the material's, textured at the hit (scene/checker.h)
-    Vec3f displacement{0.f};  // how far the hit object moves over the whole shutter (world)
+    const RigidMotion* motion = nullptr;  // how the hit object moves over the shutter, or null: it is still
 };
 
 /// Nearest and farthest occluder distances along a segment (t measured from its origin).
@@ -119,7 +119,7 @@ private:
         uint32_t object = 0;
         bool sphere = false;
         const Vec3f* cornerNormals = nullptr;  // 3 per primitive, or null: flat shading
-        Vec3f displacement{0.f};  // meshes: over the whole shutter (spheres: their own, by primitive)
+        RigidMotion motion;  // meshes: over the whole shutter (spheres: their own, m_sphereMotion)
         const Vec2f* cornerUVs = nullptr;  // 3 per primitive, or null
     };
 
@@ -129,6 +129,7 @@ private:
     std::vector<GeometryInfo> m_geometry;  // by Embree geometry id in m_scene (a moving mesh: its instance's)
     std::vector<RTCScene> m_moving;        // each moving mesh's own scene, instanced in m_scene
     std::vector<uint32_t> m_sphereMaterials;
+    std::vector<RigidMotion> m_sphereMotion;  // by primitive, where a sphere moves (else empty)
     Vec3f m_lo{kInf}, m_hi{-kInf};
     float m_extent = 1.f;
 };

@@ -31,7 +31,7 @@ Vec3f TextureMap::lookup(Vec2f uv) const {
 bool SceneDesc::hasMotion() const {
     if (camera.velocity != Vec3f(0.f) || camera.lookAtVelocity != Vec3f(0.f)) return true;  // everything moves on the screen
     for (auto& m : meshes)
-        if (m.velocity != Vec3f(0.f)) return true;
+        if (m.moves()) return true;
     for (auto& s : spheres)
         if (s.velocity != Vec3f(0.f)) return true;
     return false;

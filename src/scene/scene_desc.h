@@ -120,8 +120,31 @@ std::vector<uint32_t> lightGroups(const std::vector<AreaLight>& lights);
 /// and every pixel sums the closed-form irradiance of every light.
 constexpr size_t kMaxLights = 256;
 
+/// An object's rigid motion over the shutter, t its normalised time (0 at open, 1 at close): the
+/// point p0 of the object at shutter open is at pivot + displacement t + R(radians t) (p0 -
+/// pivot), R the rotation about `axis` (unit) through the pivot. A translation alone has
+/// radians 0 (the pivot is then unused).
+struct RigidMotion {
+    Vec3f displacement{0.f};  // over the whole shutter
+    Vec3f pivot{0.f}, axis{0, 1, 0};
+    float radians = 0;  // turned over the whole shutter
+    bool turns() const { return radians != 0; }
+    bool moves() const { return turns() || displacement != Vec3f(0.f); }
+    /// Where the object's point p0 at shutter open is at time t.
+    Vec3f at(const Vec3f& p0, float t) const {
+        return turns() ? pivot + displacement * t + rotate(p0 - pivot, axis, radians * t) : p0 + displacement * t;
+    }
+    /// The object's point at shutter open that is at p at time t.
+    Vec3f atOpen(const Vec3f& p, float t) const {
+        return turns() ? pivot + rotate(p - displacement * t - pivot, axis, -radians * t) : p - displacement * t;
+    }
+    /// A direction of the object at shutter open (a normal) as it is turned at time t.
+    Vec3f turn(const Vec3f& v, float t) const { return turns() ? rotate(v, axis, radians * t) : v; }
+};
+
 /// Triangles in world space at shutter open; `velocity` (world units per unit of shutter time)
-/// moves the whole mesh by velocity x CameraDesc::shutterLength() over the shutter.
+/// moves the whole mesh by velocity x CameraDesc::shutterLength() over the shutter, and
+/// `turnDegrees` (degrees per unit of shutter time) turns it about `turnAxis` through `pivot`.
 struct TriangleMesh {
     std::string name;
     std::vector<Vec3f> positions;
@@ -135,7 +158,14 @@ struct TriangleMesh {
     /// empty.
     std::vector<Vec2f> cornerUVs;
     Vec3f velocity{0.f};
+    Vec3f turnAxis{0, 1, 0}, pivot{0.f};  // turnAxis: unit length
+    float turnDegrees = 0;
     size_t triangleCount() const { return indices.size() / 3; }
+    bool moves() const { return velocity != Vec3f(0.f) || turnDegrees != 0; }
+    /// Its motion over a shutter of the given length.
+    RigidMotion motion(float shutterLength) const {
+        return {velocity * shutterLength, pivot, turnAxis, turnDegrees * shutterLength * (kPi / 180.f)};
+    }
 };
 
 struct Sphere {

@@ -11,6 +11,7 @@
 #include <exception>
 #include <filesystem>
 #include <map>
+#include <optional>
 #include <unordered_map>
 
 #include "core/error.h"
@@ -245,6 +246,19 @@ private:
             TriangleMesh mesh;
             mesh.name = type + "[" + std::to_string(i) + "]";
             if (auto v = o.optional("velocity")) mesh.velocity = v->vec3();
+            // A turn over the shutter: [axis_x, axis_y, axis_z, degrees per unit of shutter time],
+            // about `pivot` (by default the centre of the object's box at shutter open).
+            const std::optional<JsonNode> turn = o.optional("angular_velocity");
+            if (turn) {
+                if (turn->size() != 4) turn->fail("expected [axis_x, axis_y, axis_z, degrees per unit of shutter time]");
+                const Vec3f axis((*turn)[0].number(), (*turn)[1].number(), (*turn)[2].number());
+                if (!(length(axis) > 0)) turn->fail("the axis must be non-zero");
+                mesh.turnAxis = normalize(axis);
+                mesh.turnDegrees = (*turn)[3].number();
+                if (type == "sphere") turn->fail("a sphere does not turn (meshes, quads and boxes do)");
+            }
+            const std::optional<JsonNode> pivot = o.optional("pivot");
+            if (pivot && !turn) pivot->fail("a pivot needs an angular_velocity to turn about it");
             if (type == "mesh") {
                 parseMesh(o, mesh);
             } else if (type == "quad") {
@@ -252,7 +266,7 @@ private:
                 if (length(cross(e1, e2)) <= 0) o["edge2"].fail("edge1 and edge2 span no area");
                 uint32_t mat = material(o["material"]);
                 appendQuad(mesh, corner, e1, e2, mat);
-                promoteIfEmissive(o, mat, {{corner, e1, e2, m_desc.materials[mat].emission}}, mesh.velocity, "this quad");
+                promoteIfEmissive(o, mat, {{corner, e1, e2, m_desc.materials[mat].emission}}, mesh.moves(), "this quad");
             } else if (type == "box") {
                 Vec3f lo = o["min"].vec3(), hi = o["max"].vec3();
                 if (!(hi.x > lo.x && hi.y > lo.y && hi.z > lo.z)) o["max"].fail("expected max > min in every axis");
@@ -260,7 +274,7 @@ private:
                 appendBox(mesh, lo, hi, mat);
                 std::vector<AreaLight> faces;
                 for (const auto& f : boxFaces(lo, hi)) faces.push_back({f[0], f[1], f[2], m_desc.materials[mat].emission});
-                promoteIfEmissive(o, mat, faces, mesh.velocity, "this box");
+                promoteIfEmissive(o, mat, faces, mesh.moves(), "this box");
             } else if (type == "sphere") {
                 Sphere s;
                 s.center = o["center"].vec3();
@@ -273,7 +287,7 @@ private:
                 light.corner = s.center;
                 light.radius = s.radius;
                 light.radiance = m_desc.materials[s.material].emission;
-                promoteIfEmissive(o, s.material, {light}, s.velocity, "this sphere");
+                promoteIfEmissive(o, s.material, {light}, s.velocity != Vec3f(0.f), "this sphere");
                 o.finish();
                 m_desc.spheres.push_back(s);
                 continue;
@@ -281,6 +295,19 @@ private:
                 o["type"].fail("unknown object type '" + type + "' (expected mesh, quad, box or sphere)");
             }
             checkExtent(o, mesh.positions, mesh.velocity);
+            if (turn) {
+                if (pivot) {
+                    mesh.pivot = pivot->vec3();
+                } else {
+                    Vec3f lo(kInf), hi(-kInf);
+                    for (const Vec3f& p : mesh.positions) lo = vmin(lo, p), hi = vmax(hi, p);
+                    mesh.pivot = (lo + hi) * 0.5f;
+                }
+                // Every point stays within its distance to the pivot, which moves by velocity.
+                float r = 0;
+                for (const Vec3f& p : mesh.positions) r = std::max(r, length(p - mesh.pivot));
+                checkExtent(pivot ? *pivot : *turn, {mesh.pivot - Vec3f(r), mesh.pivot + Vec3f(r)}, mesh.velocity);
+            }
             o.finish();
             m_desc.meshes.push_back(std::move(mesh));
         }
@@ -312,7 +339,7 @@ private:
             l.edge2 = xf.apply(l.corner + l.edge2) - c0;
             l.corner = c0;
         }
-        addLights(o, promoted, mesh.velocity, "'" + fileNode.string() + "'");
+        addLights(o, promoted, mesh.moves(), "'" + fileNode.string() + "'");
     }
 
     /// Light comes from the scene's lights and from the emitters that do not move: quads, boxes'
@@ -321,10 +348,10 @@ private:
 
     /// Adds an object's emissive faces (those of `owner`) as lights: all of them, or none where
     /// the object moves or they would take the scene past kMaxLights.
-    void addLights(const JsonNode& o, const std::vector<AreaLight>& faces, const Vec3f& velocity, const std::string& owner) {
+    void addLights(const JsonNode& o, const std::vector<AreaLight>& faces, bool moving, const std::string& owner) {
         if (faces.empty()) return;
         std::string why;
-        if (velocity != Vec3f(0.f)) why = "moving emitters are not lights";
+        if (moving) why = "moving emitters are not lights";
         else if (m_desc.lights.size() + faces.size() > kMaxLights)
             why = "the scene has " + std::to_string(m_desc.lights.size()) + " lights before them and takes " +
                   std::to_string(kMaxLights) + " at most";
@@ -335,9 +362,9 @@ private:
     }
 
     /// `faces` of material `mat` as lights, if it emits.
-    void promoteIfEmissive(const JsonNode& o, uint32_t mat, const std::vector<AreaLight>& faces, const Vec3f& velocity,
+    void promoteIfEmissive(const JsonNode& o, uint32_t mat, const std::vector<AreaLight>& faces, bool moving,
                            const std::string& owner) {
-        if (m_desc.materials[mat].isEmitter()) addLights(o, faces, velocity, owner);
+        if (m_desc.materials[mat].isEmitter()) addLights(o, faces, moving, owner);
     }
 
     /// Every point, at the shutter's open and close (moved by velocity x (close - open)), within
