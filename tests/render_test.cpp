@@ -332,6 +332,43 @@ TEST(Render, MotionBlurIsTheShutterAverage) {
     }
 }
 
+namespace {
+
+/// A lit strip 0.2 x 2 at depth 4, from x0 to x0 + 0.2, over nothing, under a 200 x 200 light 64
+/// away behind a camera at the origin looking down -z (fov_y 10, 64 x 16, 64 spp): where the
+/// strip or the camera moves, its light hardly changes. `camera` and `strip`: keys added to the
+/// camera and to the strip (each "" or starting with ", ").
+std::string litStrip(float x0, const std::string& camera, const std::string& strip, int seed) {
+    std::string json = R"({
+      "camera": {"position": [0, 0, 0], "look_at": [0, 0, -1], "up": [0, 1, 0], "fov_y": 10, "resolution": [64, 16]CAMERA},
+      "materials": {"white": {"albedo": [0.8, 0.8, 0.8]}},
+      "lights": [{"type": "parallelogram", "corner": [-100, -100, 60], "edge1": [0, 200, 0], "edge2": [200, 0, 0], "radiance": [1, 1, 1]}],
+      "objects": [{"type": "quad", "corner": [X0, -1, -4], "edge1": [0.2, 0, 0], "edge2": [0, 2, 0], "material": "white"STRIP}],
+      "render": {"spp": 64, "seed": SEED, "indirect": false}
+    })";
+    for (const auto& [key, value] : {std::pair<std::string, std::string>{"CAMERA", camera}, {"X0", std::to_string(x0)},
+                                     {"STRIP", strip}, {"SEED", std::to_string(seed)}})
+        json.replace(json.find(key), key.size(), value);
+    return json;
+}
+
+/// The still strip's radiance (its middle column's mean, by MC at 64 spp without layers).
+double litStripRadiance(float x0) {
+    render::RenderOptions o;
+    o.quiet = true;
+    o.method = "mc";
+    o.layers = "off";
+    const std::string json = litStrip(x0, "", "", 3);
+    const render::RenderResult still = renderJson(json, o);
+    const render::Camera cam(parse(json).camera);
+    const int mid = int(cam.project({x0 + 0.1f, 0.f, -4.f}).x);
+    double radiance = 0;
+    for (int y = 0; y < 16; ++y) radiance += still.color(mid, y).y / 16;
+    return radiance;
+}
+
+}  // namespace
+
 TEST(Render, AMovingCameraIsTheSceneMovingTheOtherWay) {
     // The camera translating by -v over the shutter sees what a still camera sees of the scene
     // translating by +v, where the light hardly depends on where things are: a lit strip over
@@ -344,29 +381,14 @@ TEST(Render, AMovingCameraIsTheSceneMovingTheOtherWay) {
     // Each render is also checked against the strip's shutter average (as
     // Layers.AMovingSquareIsItsShutterAverage), so that the two cannot be wrong alike.
     auto scene = [](const std::string& cameraVelocity, const std::string& stripVelocity, bool lens) {
-        std::string json = R"({
-          "camera": {"position": [0, 0, 0], "look_at": [0, 0, -1], "up": [0, 1, 0], "fov_y": 10, "resolution": [64, 16],
-                     LENS "velocity": [CAMERA]},
-          "materials": {"white": {"albedo": [0.8, 0.8, 0.8]}},
-          "lights": [{"type": "parallelogram", "corner": [-100, -100, 60], "edge1": [0, 200, 0], "edge2": [200, 0, 0], "radiance": [1, 1, 1]}],
-          "objects": [{"type": "quad", "corner": [-0.4, -1, -4], "edge1": [0.2, 0, 0], "edge2": [0, 2, 0], "material": "white",
-                       "velocity": [STRIP]}],
-          "render": {"spp": 64, "seed": 5, "indirect": false}
-        })";
-        json.replace(json.find("LENS"), 4, lens ? R"("aperture_radius": 0.02, "focus_distance": 3,)" : "");
-        json.replace(json.find("CAMERA"), 6, cameraVelocity);
-        json.replace(json.find("STRIP"), 5, stripVelocity);
-        return json;
+        const std::string aperture = lens ? R"(, "aperture_radius": 0.02, "focus_distance": 3)" : "";
+        return litStrip(-0.4f, aperture + R"(, "velocity": [)" + cameraVelocity + "]", R"(, "velocity": [)" + stripVelocity + "]", 5);
     };
     render::RenderOptions o;
     o.quiet = true;
     o.method = "mc";
-    o.layers = "off";
-    const render::RenderResult still = renderJson(scene("0, 0, 0", "0, 0, 0", false), o);
     const render::Camera cam(parse(scene("0, 0, 0", "0, 0, 0", false)).camera);
-    double radiance = 0;  // the still strip's, at its middle column
-    const int mid = int(cam.project({-0.3f, 0.f, -4.f}).x);
-    for (int y = 0; y < 16; ++y) radiance += still.color(mid, y).y / 16;
+    const double radiance = litStripRadiance(-0.4f);
     ASSERT_GT(radiance, 0.01);
     for (bool lens : {false, true})
         for (const char* layers : {"off", "on"}) {
@@ -501,28 +523,12 @@ TEST(Render, ATurningCameraBlursAStripOverItsSweep) {
     // which its ray (the camera's at that time) meets the strip, averaged over the pixel. With
     // and without layers (the sweep, 9.1 px, twice the strip's width), the columns' means against
     // that share (integrated over 256 times and 16 positions in the pixel).
-    auto scene = [](const char* lookAtVelocity) {
-        std::string json = R"({
-          "camera": {"position": [0, 0, 0], "look_at": [0, 0, -1], "up": [0, 1, 0], "fov_y": 10, "resolution": [64, 16],
-                     "look_at_velocity": [LOOK]},
-          "materials": {"white": {"albedo": [0.8, 0.8, 0.8]}},
-          "lights": [{"type": "parallelogram", "corner": [-100, -100, 60], "edge1": [0, 200, 0], "edge2": [200, 0, 0], "radiance": [1, 1, 1]}],
-          "objects": [{"type": "quad", "corner": [-0.2, -1, -4], "edge1": [0.2, 0, 0], "edge2": [0, 2, 0], "material": "white"}],
-          "render": {"spp": 64, "seed": 7, "indirect": false}
-        })";
-        json.replace(json.find("LOOK"), 4, lookAtVelocity);
-        return json;
-    };
     render::RenderOptions o;
     o.quiet = true;
     o.method = "mc";
-    o.layers = "off";
-    const render::RenderResult still = renderJson(scene("0, 0, 0"), o);
-    const std::string turning = scene("0.1, 0, 0");
-    const render::Camera cam(parse(turning).camera), stillCam(parse(scene("0, 0, 0")).camera);
-    double radiance = 0;
-    const int mid = int(stillCam.project({-0.1f, 0.f, -4.f}).x);
-    for (int y = 0; y < 16; ++y) radiance += still.color(mid, y).y / 16;
+    const std::string turning = litStrip(-0.2f, R"(, "look_at_velocity": [0.1, 0, 0])", "", 7);
+    const render::Camera cam(parse(turning).camera);
+    const double radiance = litStripRadiance(-0.2f);
     ASSERT_GT(radiance, 0.01);
     std::vector<double> share(64, 0.0);
     for (int x = 0; x < 64; ++x)
