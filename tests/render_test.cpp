@@ -367,6 +367,21 @@ double litStripRadiance(float x0) {
     return radiance;
 }
 
+/// A wall at depth 4 and a post 0.1 wide at depth 2 before a pinhole at the origin looking down
+/// -z (fov_y 20, 32 x 32), `camera` a key added to its camera (its motion).
+std::string wallAndPost(const std::string& camera) {
+    std::string json = R"({
+      "camera": {"position": [0, 0, 0], "look_at": [0, 0, -1], "up": [0, 1, 0], "fov_y": 20, "resolution": [32, 32], CAMERA},
+      "materials": {"white": {"albedo": [0.8, 0.8, 0.8]}},
+      "lights": [{"type": "parallelogram", "corner": [-1, 3, -3], "edge1": [2, 0, 0], "edge2": [0, 0, 1], "radiance": [1, 1, 1]}],
+      "objects": [{"type": "quad", "corner": [-10, -10, -4], "edge1": [20, 0, 0], "edge2": [0, 20, 0], "material": "white"},
+                  {"type": "box", "min": [-0.05, -1, -2.05], "max": [0.05, 1, -1.95], "material": "white"}],
+      "render": {"spp": 16, "seed": 3, "indirect": false}
+    })";
+    json.replace(json.find("CAMERA"), 6, camera);
+    return json;
+}
+
 }  // namespace
 
 TEST(Render, AMovingCameraIsTheSceneMovingTheOtherWay) {
@@ -429,16 +444,7 @@ TEST(Render, AMovingCamerasSamplesMoveOnTheScreenByItsParallax) {
     // and its place in depth from) and moves on the screen by f (P.x - 0.2) / (-P.z - 0.5) -
     // f P.x / -P.z pixels across and the like down over the shutter (f: the focal length in
     // pixels): the post, nearer, moves farther. Before the camera could move, a still hit had no screen motion.
-    const std::string json = R"({
-      "camera": {"position": [0, 0, 0], "look_at": [0, 0, -1], "up": [0, 1, 0], "fov_y": 20, "resolution": [32, 32],
-                 "velocity": [0.2, 0, -0.5]},
-      "materials": {"white": {"albedo": [0.8, 0.8, 0.8]}},
-      "lights": [{"type": "parallelogram", "corner": [-1, 3, -3], "edge1": [2, 0, 0], "edge2": [0, 0, 1], "radiance": [1, 1, 1]}],
-      "objects": [{"type": "quad", "corner": [-10, -10, -4], "edge1": [20, 0, 0], "edge2": [0, 20, 0], "material": "white"},
-                  {"type": "box", "min": [-0.05, -1, -2.05], "max": [0.05, 1, -1.95], "material": "white"}],
-      "render": {"spp": 16, "seed": 3, "indirect": false}
-    })";
-    const scene::SceneDesc desc = parse(json);
+    const scene::SceneDesc desc = parse(wallAndPost(R"("velocity": [0.2, 0, -0.5])"));
     const scene::Scene sc(desc);
     const render::Camera cam(desc.camera);
     const render::PathSampler sampler(sc, cam, false, 3);
@@ -474,16 +480,7 @@ TEST(Render, ATurningCamerasSamplesMoveAlikeAtEveryDepth) {
     // at depth 2 move alike on the screen, by about f tan(2.9 degrees) = 0.05 f pixels to the
     // left. Each sample's screen motion is its point's from the camera at the shutter's open to
     // the camera at its close, and its depth is along forward(t) at its own time.
-    const std::string json = R"({
-      "camera": {"position": [0, 0, 0], "look_at": [0, 0, -1], "up": [0, 1, 0], "fov_y": 20, "resolution": [32, 32],
-                 "look_at_velocity": [0.05, 0, 0]},
-      "materials": {"white": {"albedo": [0.8, 0.8, 0.8]}},
-      "lights": [{"type": "parallelogram", "corner": [-1, 3, -3], "edge1": [2, 0, 0], "edge2": [0, 0, 1], "radiance": [1, 1, 1]}],
-      "objects": [{"type": "quad", "corner": [-10, -10, -4], "edge1": [20, 0, 0], "edge2": [0, 20, 0], "material": "white"},
-                  {"type": "box", "min": [-0.05, -1, -2.05], "max": [0.05, 1, -1.95], "material": "white"}],
-      "render": {"spp": 16, "seed": 3, "indirect": false}
-    })";
-    const scene::SceneDesc desc = parse(json);
+    const scene::SceneDesc desc = parse(wallAndPost(R"("look_at_velocity": [0.05, 0, 0])"));
     ASSERT_TRUE(desc.hasMotion());
     const scene::Scene sc(desc);
     const render::Camera cam(desc.camera);
