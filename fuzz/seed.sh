@@ -50,6 +50,16 @@ cp docs/lamps/sphere.json "$out/scene/lamp-sphere.json"
 cp docs/lamps/square-fan.json "$out/scene/lamp-square-fan.json"
 cp docs/motion.json "$out/scene/motion.json"
 cp scenes/raster/pan.json "$out/scene/raster-pan.json"
+cat > "$out/scene/turning.json" <<'JSON'
+{"camera": {"position": [0, 1, 4], "look_at": [0, 0.5, 0], "up": [0, 1, 0], "fov_y": 40, "resolution": [16, 16],
+            "shutter": [0, 0.5], "velocity": [0.2, 0, 0], "look_at_velocity": [0, 0, 0.1]},
+ "materials": {"white": {"albedo": [0.8, 0.8, 0.8]}},
+ "lights": [{"type": "parallelogram", "corner": [-0.5, 3, -0.5], "edge1": [1, 0, 0], "edge2": [0, 0, 1], "radiance": [5, 5, 5]}],
+ "objects": [{"type": "box", "min": [-0.5, 0, -0.5], "max": [0.5, 1, 0.5], "material": "white",
+              "angular_velocity": [0, 1, 0, 60], "pivot": [0, 0, 0], "velocity": [0, 0, 0.3]},
+             {"type": "quad", "corner": [-3, 0, 3], "edge1": [6, 0, 0], "edge2": [0, 0, -6], "material": "white",
+              "angular_velocity": [1, 0, 0, 5]}]}
+JSON
 { cat scenes/cornell/cornell.json; sep CornellBox-Original.obj; cat scenes/cornell/CornellBox-Original.obj
   sep CornellBox-Original.mtl; cat scenes/cornell/CornellBox-Original.mtl; } > "$out/scene/cornell-with-mesh"
 { cat docs/lamps/disc-and-triangle.json; sep disc.obj; cat docs/lamps/disc.obj; sep disc.mtl; cat docs/lamps/disc.mtl

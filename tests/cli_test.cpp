@@ -350,6 +350,8 @@ TEST(Cli, TurningObjectsAreCheckedAsTheyTurn) {
     expectRejected(scene(box + R"("angular_velocity": [0, 1, 0]})"),
                    "bad.json: objects[0].angular_velocity: expected [axis_x, axis_y, axis_z, degrees per unit of shutter time]");
     expectRejected(scene(box + R"("angular_velocity": [0, 1, 0, "fast"]})"), "bad.json: objects[0].angular_velocity[3]");
+    expectRejected(scene(box + R"("angular_velocity": [0, 1, 0, 1e30]})"),
+                   "bad.json: objects[0].angular_velocity: turns 1000000000000000000 degrees over the shutter; wedge takes at most 3600");
     // About a pivot far away the box sweeps a sphere of that radius.
     expectRejected(scene(box + R"("angular_velocity": [0, 1, 0, 10], "pivot": [1e16, 0, 0]})"), "bad.json: objects[0].pivot: reaches");
     std::string dir = tempDir(), err;

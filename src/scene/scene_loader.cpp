@@ -86,6 +86,8 @@ struct Transform {
 
 /// The largest scene coordinate (checkExtent) and shutter time wedge accepts.
 constexpr float kMaxCoordinate = 1e15f, kMaxShutterTime = 1e6f;
+/// The most a turning object turns over the shutter, in degrees (ten turns).
+constexpr double kMaxTurnDegrees = 3600;
 
 class SceneParser {
 public:
@@ -256,6 +258,12 @@ private:
                 mesh.turnAxis = normalize(axis);
                 mesh.turnDegrees = (*turn)[3].number();
                 if (type == "sphere") turn->fail("a sphere does not turn (meshes, quads and boxes do)");
+                // Embree takes at most 129 time steps, a quarter turn apart here (Scene::Scene),
+                // and the layers follow a sample's chord: ten turns a shutter is already a blur.
+                const double turned = std::abs(double(mesh.turnDegrees) * m_desc.camera.shutterLength());
+                if (!(turned <= kMaxTurnDegrees))
+                    turn->fail("turns " + std::to_string(int64_t(std::min(turned, 1e18))) + " degrees over the shutter; wedge takes at most " +
+                               std::to_string(int(kMaxTurnDegrees)));
             }
             const std::optional<JsonNode> pivot = o.optional("pivot");
             if (pivot && !turn) pivot->fail("a pivot needs an angular_velocity to turn about it");
