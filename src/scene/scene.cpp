@@ -123,7 +123,8 @@ Scene::Scene(SceneDesc desc) : m_desc(std::move(desc)) {
         m_geometry[id] = {mesh.materialIds.data(), mesh.shapeIds.data(), 0, object, false,
                           mesh.cornerNormals.size() == mesh.indices.size() ? mesh.cornerNormals.data() : nullptr,
                           motion,
-                          mesh.cornerUVs.size() == mesh.indices.size() ? mesh.cornerUVs.data() : nullptr};
+                          mesh.cornerUVs.size() == mesh.indices.size() ? mesh.cornerUVs.data() : nullptr,
+                          motion.moves(), motion.turns()};
         uint32_t shapes = 0;
         for (uint32_t sId : mesh.shapeIds) shapes = std::max(shapes, sId + 1);
         object += std::max(shapes, 1u);
@@ -154,6 +155,7 @@ Scene::Scene(SceneDesc desc) : m_desc(std::move(desc)) {
             for (auto& s : m_desc.spheres) m_sphereMotion.push_back({s.velocity * shutter});
         if (m_geometry.size() <= id) m_geometry.resize(id + 1);
         m_geometry[id] = {m_sphereMaterials.data(), nullptr, 0, object, true};
+        m_geometry[id].moves = moving;
         object += uint32_t(m_desc.spheres.size());
     }
     rtcCommitScene(m_scene);
@@ -176,10 +178,9 @@ void Scene::fillHit(const Vec3f& org, const Vec3f& dir, float t, float time, uns
     // (tests/scene_test.cpp checks both), which is our front side.
     // The object that moves, if it does (null: still). A turning mesh's normals are its own at
     // shutter open (Embree gives an instance's Ng in the instanced scene's space), turned with it.
-    const RigidMotion* motion = g.sphere ? (m_sphereMotion.empty() ? nullptr : &m_sphereMotion[primID])
-                                         : (g.motion.moves() ? &g.motion : nullptr);
-    hit.motion = motion && motion->moves() ? motion : nullptr;
-    const bool turns = hit.motion && hit.motion->turns();
+    const RigidMotion* motion = !g.moves ? nullptr : g.sphere ? &m_sphereMotion[primID] : &g.motion;
+    hit.motion = motion && motion->moves() ? motion : nullptr;  // (a still sphere among moving ones)
+    const bool turns = g.turns;
     hit.normal = normalize(turns ? hit.motion->turn(ng, time) : ng);
     hit.shadingNormal = hit.normal;
     if (g.cornerNormals) {

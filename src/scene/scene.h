@@ -121,6 +121,7 @@ private:
         const Vec3f* cornerNormals = nullptr;  // 3 per primitive, or null: flat shading
         RigidMotion motion;  // meshes: over the whole shutter (spheres: their own, m_sphereMotion)
         const Vec2f* cornerUVs = nullptr;  // 3 per primitive, or null
+        bool moves = false, turns = false;  // (motion.moves(), turns(); spheres: whether any moves, m_sphereMotion)
     };
 
     SceneDesc m_desc;
