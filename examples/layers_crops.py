@@ -6,6 +6,7 @@ crop's relMSE against the reference's crop.
 
     export PYTHONPATH=$PWD/build/python
     python3 examples/layers_crops.py --out docs/layers-crops.png     # 2 minutes on 2 cores
+    python3 examples/layers_crops.py --set camera --out docs/layers-camera-and-turns.png   # 8 minutes
 
 The crops are the rows of CROPS (scene, resolution, crop x, y, width, height); the
 reference is plain MC without layers with its own seed, so that its noise is independent of
@@ -32,6 +33,17 @@ CROPS = [
     ("motion and a lens: a bunny moving past defocused slats, over a checkered floor",
      os.path.join(HERE, "..", "docs", "bunny-slats.json"), (256, 256), 100, 126, 90, 60),
 ]
+# --set camera: a moving camera, a turning camera and a turning object (the held-out scenes of
+# docs/layers.md, "A moving camera" and "Turning objects").
+CAMERA_CROPS = [
+    ("camera moving: Sponza's hangings and columns", os.path.join(HERE, "..", "docs", "sponza-campan.json"), (512, 512),
+     20, 230, 160, 120),
+    ("camera turning: the arches at the far end", os.path.join(HERE, "..", "docs", "sponza-turn.json"), (512, 512),
+     190, 160, 160, 120),
+    ("bunny turning: its head and ears", os.path.join(HERE, "..", "docs", "bunny-turn.json"), (384, 384),
+     100, 100, 160, 120),
+]
+CROP_SETS = {"default": CROPS, "camera": CAMERA_CROPS}
 COLUMNS = [("mc", "off"), ("mc", "on"), ("aaf", "off"), ("aaf", "on")]
 
 
@@ -51,11 +63,14 @@ def main():
     p.add_argument("--scale", type=float, default=1.0,
                    help="scale of every resolution and crop (default 1; the tests run 0.125)")
     p.add_argument("--out", default="layers-crops.png", help="output PNG (default layers-crops.png)")
+    p.add_argument("--set", choices=sorted(CROP_SETS), default="default",
+                   help="the crops: a defocused silhouette, the focal plane and moving objects (default), or a "
+                        "moving camera, a turning camera and a turning object (camera)")
     a = p.parse_args()
     if not 0 < a.scale <= 4:
         p.error("--scale: expected a number in (0, 4]")
     crops = [(label, name, tuple(max(8, round(v * a.scale)) for v in res), *(max(1, round(v * a.scale)) for v in box))
-             for label, name, res, *box in CROPS]
+             for label, name, res, *box in CROP_SETS[a.set]]
 
     images = {}  # (scene, resolution) -> {column or "reference": colour}
     for _, name, res, *_ in crops:

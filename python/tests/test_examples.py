@@ -39,3 +39,10 @@ def test_layers_crops(tmp_path):
     out = tmp_path / "crops.png"
     run_example("layers_crops.py", "--scale", "0.125", "--spp", "2", "--reference-spp", "4", "--zoom", "8", "--out", out)
     check_png(out)
+
+
+def test_layers_crops_of_a_moving_and_turning_camera(tmp_path):
+    out = tmp_path / "camera.png"
+    run_example("layers_crops.py", "--set", "camera", "--scale", "0.125", "--spp", "2", "--reference-spp", "4", "--zoom", "8",
+                "--out", out)
+    check_png(out)
