@@ -300,9 +300,7 @@ void PathSampler::traceMany(const SampleRun* runs, size_t nRuns, bool span) cons
                     const float t = w.time[l];
                     const scene::RigidMotion* m = hit.motion;
                     const Vec3f atOpen = m ? m->atOpen(hit.position, t) : hit.position;
-                    const Vec3f atClose = !m ? hit.position
-                                          : m->turns() ? m->at(atOpen, 1.f)
-                                                       : hit.position + m->displacement * (1.f - t);
+                    const Vec3f atClose = m ? m->atClose(hit.position, t) : hit.position;
                     const Vec2f open = m_camera.project(atOpen, 0.f), close = m_camera.project(atClose, 1.f);
                     o.motion = {close.x - open.x, close.y - open.y};
                 }

@@ -51,8 +51,8 @@ Scene::Scene(SceneDesc desc) : m_desc(std::move(desc)) {
         const bool moving = motion.moves();
         const Vec3f displacement = motion.displacement;
         float reach = 0;  // a turning mesh's farthest point from its pivot
-        // A moving mesh translates rigidly: it is its own scene, built once at shutter open with
-        // the scene's quality, and instanced with a transform per time step. (As a triangle mesh
+        // A moving mesh moves rigidly (it translates, and may turn): it is its own scene, built once
+        // at shutter open with the scene's quality, and instanced with a transform per time step. (As a triangle mesh
         // with two vertex time steps it took Embree's motion-blur BVH, at medium quality: the
         // moving Sponza of docs/sponza-pan.json traced at about half the rays per second of the
         // still one; docs/sampling-speed.md, "A moving mesh as a moving instance".)
@@ -204,7 +204,7 @@ void Scene::fillHit(const Vec3f& org, const Vec3f& dir, float t, float time, uns
     } else {
         // The texture is attached to the object: look it up where the point was at shutter open
         // (with the normal it had then, which picks the checker's plane).
-        hit.albedo = hit.motion ? albedoAt(m, hit.motion->atOpen(hit.position, time), turns ? hit.motion->turn(hit.normal, -time) : hit.normal)
+        hit.albedo = hit.motion ? albedoAt(m, hit.motion->atOpen(hit.position, time), hit.motion->turn(hit.normal, -time))
                                 : albedoAt(m, hit.position, hit.normal);
     }
 }

@@ -138,6 +138,10 @@ struct RigidMotion {
     Vec3f atOpen(const Vec3f& p, float t) const {
         return turns() ? pivot + rotate(p - displacement * t - pivot, axis, -radians * t) : p - displacement * t;
     }
+    /// Where the point that is at p at time t is at shutter close: at(atOpen(p, t), 1), or for a
+    /// translation p + displacement (1 - t) (the same to float rounding; so written, a
+    /// translation's samples keep the screen motion they had before objects could turn).
+    Vec3f atClose(const Vec3f& p, float t) const { return turns() ? at(atOpen(p, t), 1.f) : p + displacement * (1.f - t); }
     /// A direction of the object at shutter open (a normal) as it is turned at time t.
     Vec3f turn(const Vec3f& v, float t) const { return turns() ? rotate(v, axis, radians * t) : v; }
 };

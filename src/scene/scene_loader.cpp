@@ -149,10 +149,11 @@ private:
             cam.velocity = v->vec3();
             checkExtent(*v, {cam.position}, cam.velocity);
         }
-        cam.lookAtVelocity = cam.velocity;  // unless given: the camera keeps its orientation
-        if (auto v = c.optional("look_at_velocity")) cam.lookAtVelocity = v->vec3();
+        const std::optional<JsonNode> lookAtVelocity = c.optional("look_at_velocity");
+        // Unless given, look_at moves with the camera, which keeps its orientation.
+        cam.lookAtVelocity = lookAtVelocity ? lookAtVelocity->vec3() : cam.velocity;
         {
-            JsonNode where = c.optional("look_at_velocity") ? *c.optional("look_at_velocity") : c["look_at"];
+            const JsonNode where = lookAtVelocity ? *lookAtVelocity : c["look_at"];
             checkExtent(where, {cam.lookAt}, cam.lookAtVelocity);
             // The view direction a + b t over the shutter (t in [0, 1]) must not vanish or turn
             // parallel to up: its part across up, a linear function of t, is nearest zero at t*.
