@@ -105,7 +105,7 @@ static_assert(std::is_trivially_copyable_v<LightFieldSample> && std::is_triviall
 class LightFieldSamples {
 public:
     LightFieldSamples() = default;
-    LightFieldSamples(int width, int height) : m_width(width), m_height(height) {}
+    LightFieldSamples(int width, int height) : m_width(width), m_height(height), m_bentReach(size_t(width) * height, 0.f) {}
 
     int width() const { return m_width; }
     int height() const { return m_height; }
@@ -155,8 +155,22 @@ public:
         for (const Stage& s : m_stages) n += s.samples.size();
         return n;
     }
+    /// Per pixel, how far (pixels, a square) from it the samples it holds whose paths bend more
+    /// than kBentPath reach once reprojected (0: none does); marked as they are recorded
+    /// (LightFieldStage::record). The layered reconstruction follows each sample's chord, so
+    /// around such a path it reconstructs the arc's sagitta as a smear; aaf and maaf keep their
+    /// own composition within that reach (render/renderer.cpp, docs/layers.md, "Arcs").
+    float bentReach(size_t p) const { return m_bentReach[p]; }
+    void markBent(size_t p, float reach) { m_bentReach[p] = std::max(m_bentReach[p], reach); }
+    float* bentReachData() { return m_bentReach.data(); }
+    /// A path that bends more than this (pixels) from its chord at mid-shutter is bent. AAF
+    /// relMSE at 1 / 2 / 3 px against no such rule, three seeds each: docs/bunny-turn.json (40
+    /// degrees) +8..+21% / -1..-6% / -8..-12%; a room with a bunny turning 20 degrees, a box 40
+    /// and a bar 67 -3..-16% / -3..-16% / +6..+7% (docs/layers.md, "Arcs").
+    static constexpr float kBentPath = 2.f;
+
     size_t bytes() const {
-        size_t b = 0;
+        size_t b = 0;  // (the samples; bentReach's 4 bytes a pixel beside them are not counted)
         for (const Stage& s : m_stages) b += s.samples.size() * sizeof(LightFieldSample) + s.offset.size() * sizeof(uint64_t);
         return b;
     }
@@ -172,6 +186,7 @@ private:
     };
     int m_width = 0, m_height = 0;
     std::vector<Stage> m_stages;
+    std::vector<float> m_bentReach;
 };
 
 }  // namespace wedge

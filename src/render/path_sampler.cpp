@@ -303,6 +303,14 @@ void PathSampler::traceMany(const SampleRun* runs, size_t nRuns, bool span) cons
                     const Vec3f atClose = m ? m->atClose(hit.position, t) : hit.position;
                     const Vec2f open = m_camera.project(atOpen, 0.f), close = m_camera.project(atClose, 1.f);
                     o.motion = {close.x - open.x, close.y - open.y};
+                    // Where it is at mid-shutter, off the chord's line (along it, the rate of an
+                    // object moving in depth is the stage's alongChord): the sagitta of an arc,
+                    // r (1 - cos(a / 2)) for a turn of a.
+                    const Vec3f atMid = m ? m->at(atOpen, 0.5f) : hit.position;
+                    const Vec2f mid = m_camera.project(atMid, 0.5f);
+                    const float ox = mid.x - 0.5f * (open.x + close.x), oy = mid.y - 0.5f * (open.y + close.y);
+                    const float chord = std::sqrt(o.motion.x * o.motion.x + o.motion.y * o.motion.y);
+                    o.bend = chord > 1e-3f ? std::abs(ox * o.motion.y - oy * o.motion.x) / chord : std::sqrt(ox * ox + oy * oy);
                 }
                 if (front) o.emission = mat.emission;  // emitters shine from their front side
                 const LightSample& ls = w.ls[l] = sampleLight(hit.position, w.normal[l], w.uLight[l], w.choice[l]);

@@ -33,6 +33,10 @@ struct TracedSample {
     // through the lens centre): the light-field coordinates of the layered reconstruction.
     Vec2f film{0.f, 0.f}, motion{0.f, 0.f};
     float time = 0;
+    // How far (pixels) its hit's path on the screen strays from that motion's chord at
+    // mid-shutter: the bend of a turning object's arc (or of a turning camera's projection),
+    // which the layered reconstruction's straight trajectories miss (LightFieldSamples::bentReach).
+    float bend = 0;
     // Shadow ray of the primary hit (only when the light faced the receiver).
     bool shadowTested = false, occluded = false;
     bool selfShadowed = false;     // the light is above the shading normal's horizon but below the facet's

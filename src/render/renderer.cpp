@@ -87,27 +87,57 @@ uint64_t denseEmission(const MethodContext& ctx, const Image<uint32_t>& topUp, F
 
 namespace {
 
-/// result.methodPixels for aaf and maaf with a light field: the pixels with none within
-/// filter::kSilhouetteReach whose samples saw several surfaces (a miss counts as another surface,
-/// as in the stage), left to their own composition. Each rank marks its own rows' pixels, and
-/// every rank gets the whole mask. (docs/layers.md, "Blocks without a silhouette left to the
-/// filters" and "Pixels away from a silhouette left to the filters".)
+/// result.methodPixels for aaf and maaf with a light field: the pixels left to their own
+/// composition. Each rank marks its own rows' pixels, and every rank gets the whole mask.
+/// - The pixels with none within filter::kSilhouetteReach whose samples saw several surfaces (a
+///   miss counts as another surface, as in the stage). (docs/layers.md, "Blocks without a
+///   silhouette left to the filters" and "Pixels away from a silhouette left to the filters".)
+/// - Every pixel within reach of a sample whose path bends (LightFieldSamples::bentReach: the
+///   arc of a turning object). The layers follow chords and misplace such a sample by up to its
+///   arc's sagitta, which in filtered light, with little noise of its own to hide it, measured
+///   worse than the filters' own composition. mc and atrous keep the layers there: their own
+///   composition of a moving pixel is noisier (16 samples, no top-up), and measured worse
+///   (docs/layers.md, "Arcs").
 void leavePixelsToTheMethod(const MethodContext& ctx, const PixelStatsImage& stats, RenderResult& result) {
     if (!ctx.lightField || (ctx.options.method != "aaf" && ctx.options.method != "maaf")) return;
-    const LightFieldSamples& lf = *ctx.lightField;
-    Image<uint8_t> mixed(stats.width(), stats.height());
-    parallelRows(stats.height(), [&](int y) {
+    LightFieldSamples& lf = *ctx.lightField;
+    const int W = stats.width(), H = stats.height();
+    Image<uint8_t> mixed(W, H);
+    parallelRows(H, [&](int y) {
         if (!ctx.sampler.tracesRow(y)) return;
-        for (int x = 0; x < stats.width(); ++x) {
+        for (int x = 0; x < W; ++x) {
             const int primary = stats(x, y).primary();
-            const size_t p = size_t(y) * stats.width() + x;
+            const size_t p = size_t(y) * W + x;
             lf.forEach(p, [&](const LightFieldSample& s) {
                 if (s.surface() != primary) mixed[p] = 1;
             });
         }
     });
-    exchangeImageRows(ctx.sampler.distribution(), mixed.data(), stats.width(), stats.height());
+    exchangeImageRows(ctx.sampler.distribution(), mixed.data(), W, H);
     result.methodPixels = filter::pixelsAwayFromSilhouettes(mixed, filter::kSilhouetteReach);
+
+    // The squares around the bent samples' pixels, through a difference table: +1 and -1 at
+    // their corners, then sums along the rows and the columns.
+    exchangeImageRows(ctx.sampler.distribution(), lf.bentReachData(), W, H);
+    std::vector<int32_t> cover;
+    for (int y = 0; y < H; ++y)
+        for (int x = 0; x < W; ++x) {
+            const float reach = lf.bentReach(size_t(y) * W + x);
+            if (!(reach > 0.f)) continue;
+            if (cover.empty()) cover.assign(size_t(W + 1) * (H + 1), 0);
+            const int r = int(std::ceil(std::min(reach, float(W + H))));
+            const int x0 = std::max(0, x - r), x1 = std::min(W, x + r + 1), y0 = std::max(0, y - r), y1 = std::min(H, y + r + 1);
+            cover[size_t(y0) * (W + 1) + x0] += 1, cover[size_t(y0) * (W + 1) + x1] -= 1;
+            cover[size_t(y1) * (W + 1) + x0] -= 1, cover[size_t(y1) * (W + 1) + x1] += 1;
+        }
+    if (cover.empty()) return;
+    for (int y = 0; y <= H; ++y)
+        for (int x = 1; x <= W; ++x) cover[size_t(y) * (W + 1) + x] += cover[size_t(y) * (W + 1) + x - 1];
+    for (int y = 1; y <= H; ++y)
+        for (int x = 0; x <= W; ++x) cover[size_t(y) * (W + 1) + x] += cover[size_t(y - 1) * (W + 1) + x];
+    for (int y = 0; y < H; ++y)
+        for (int x = 0; x < W; ++x)
+            if (cover[size_t(y) * (W + 1) + x] > 0) result.methodPixels[size_t(y) * W + x] = 1;
 }
 
 }  // namespace
