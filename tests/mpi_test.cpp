@@ -114,19 +114,20 @@ TEST(Mpi, MaafIsBitIdenticalToOneProcess) {
 
 TEST(Mpi, AafAroundATurningBarIsBitIdenticalToOneProcess) {
     REQUIRE_MPI();
-    // A bar turning 120 degrees before a wall, and a moving box's silhouette beyond its reach:
-    // aaf keeps its own image within reach of the samples whose paths bend
-    // (LightFieldSamples::bentReach), and the layers' at the box. A rank marks the pixels of its
-    // rows, and the marks are exchanged before the mask is made (without the exchange the images
-    // differ at -n 2 and -n 3).
+    // A bar turning 120 degrees about (0, 1, 1) before a wall, and a moving post across the edge
+    // of its reach: aaf keeps its own image within reach of the samples whose paths bend
+    // (LightFieldSamples::bentReach), and the layers' along the rest of the post. A rank marks
+    // the pixels of its rows, and the marks are exchanged before the mask is made (without the
+    // exchange the images differ at -n 2 and -n 3: the rows are dealt in turn, so a rank's marks
+    // alone reach nearly, not exactly, as far).
     const std::string dir = tempDir();
     writeFile(dir + "/turn.json", R"({
       "camera": {"position": [0, 0, 0], "look_at": [0, 0, -1], "up": [0, 1, 0], "fov_y": 20, "resolution": [64, 48]},
       "materials": {"white": {"albedo": [0.8, 0.8, 0.8]}},
       "lights": [{"type": "parallelogram", "corner": [-1, 2, -3], "edge1": [0, 0, -2], "edge2": [2, 0, 0], "radiance": [5, 5, 5]}],
       "objects": [{"type": "quad", "corner": [-0.45, -0.45, -4], "edge1": [0.5, 0, 0], "edge2": [0, 0.08, 0], "material": "white",
-                   "angular_velocity": [0, 0, 1, 120]},
-                  {"type": "box", "min": [-0.3, 0.45, -3.5], "max": [-0.1, 0.55, -3.4], "material": "white", "velocity": [0.1, 0, 0]},
+                   "angular_velocity": [0, 1, 1, 120]},
+                  {"type": "box", "min": [0.2, -0.6, -3.5], "max": [0.3, 0.3, -3.4], "material": "white", "velocity": [0.1, 0, 0]},
                   {"type": "quad", "corner": [-3, -3, -6], "edge1": [6, 0, 0], "edge2": [0, 6, 0], "material": "white"}],
       "render": {"spp": 4, "seed": 5, "indirect": true}
     })");

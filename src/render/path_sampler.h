@@ -37,6 +37,11 @@ struct TracedSample {
     // mid-shutter: the bend of a turning object's arc (or of a turning camera's projection),
     // which the layered reconstruction's straight trajectories miss (LightFieldSamples::bentReach).
     float bend = 0;
+    // Where bend > LightFieldSamples::kBentPath (else 0): how much its surface turns towards or
+    // away from the camera over the shutter, |cos at close - cos at open| of the angle between
+    // its normal and the direction to the camera. A spin in the image plane (a fan, a wheel
+    // seen face on) turns nothing towards the camera.
+    float faceTurn = 0;
     // Shadow ray of the primary hit (only when the light faced the receiver).
     bool shadowTested = false, occluded = false;
     bool selfShadowed = false;     // the light is above the shading normal's horizon but below the facet's

@@ -92,12 +92,12 @@ namespace {
 /// - The pixels with none within filter::kSilhouetteReach whose samples saw several surfaces (a
 ///   miss counts as another surface, as in the stage). (docs/layers.md, "Blocks without a
 ///   silhouette left to the filters" and "Pixels away from a silhouette left to the filters".)
-/// - Every pixel within reach of a sample whose path bends (LightFieldSamples::bentReach: the
-///   arc of a turning object). The layers follow chords and misplace such a sample by up to its
-///   arc's sagitta, which in filtered light, with little noise of its own to hide it, measured
-///   worse than the filters' own composition. mc and atrous keep the layers there: their own
-///   composition of a moving pixel is noisier (16 samples, no top-up), and measured worse
-///   (docs/layers.md, "Arcs").
+/// - Every pixel within reach of a sample whose path bends on a surface turning towards or away
+///   from the camera (LightFieldSamples::bentReach: a turning object). The layers follow chords
+///   and hold one sharp image per layer at mid-shutter, and there, in filtered light with little
+///   noise of its own to hide their error, measured worse than the filters' own composition.
+///   mc and atrous keep the layers there: their own composition of a moving pixel is noisier
+///   (16 samples, no top-up), and measured worse (docs/layers.md, "Arcs").
 void leavePixelsToTheMethod(const MethodContext& ctx, const PixelStatsImage& stats, RenderResult& result) {
     if (!ctx.lightField || (ctx.options.method != "aaf" && ctx.options.method != "maaf")) return;
     LightFieldSamples& lf = *ctx.lightField;

@@ -41,10 +41,11 @@ public:
         const SampleRecord& r = s.record;
         m_lf->run(m_stage, p)[m_fill[p]++] = LightFieldSample::pack(
             s.film, r.lens, s.time, s.hit ? s.depth : kInf, s.motion, s.albedo, s.albedo * (r.direct + r.indirect), slot);
-        // A sample at film x and time t lands in its layer's sharp image within |m| / 2 of x,
-        // where a ray of a pixel within |m| / 2 of it reads it; the bend and the grid's blur
+        // A bent path on a surface that turns towards or away from the camera (render/renderer.cpp,
+        // leavePixelsToTheMethod). The sample lands in its layer's sharp image within |m| / 2 of
+        // x, where a ray of a pixel within |m| / 2 of it reads it; the bend and the grid's blur
         // (2 px) on top.
-        if (s.bend > LightFieldSamples::kBentPath)
+        if (s.bend > LightFieldSamples::kBentPath && s.faceTurn > LightFieldSamples::kFaceTurn)
             m_lf->markBent(p, std::sqrt(s.motion.x * s.motion.x + s.motion.y * s.motion.y) + s.bend + 2.f);
     }
 
