@@ -164,6 +164,9 @@ Result renderScene(const Scene& s, const py::kwargs& kwargs) {
         scene::Scene built(std::move(desc));
         return render::render(built, options);
     });
+    // What `wedge render` prints as a warning after the render, as a Python warning.
+    if (const std::string unlit = render::unlitWarning(s.desc, r.result); !unlit.empty())
+        if (PyErr_WarnEx(PyExc_UserWarning, (s.name + ": " + unlit).c_str(), 1) < 0) throw py::error_already_set();
     return r;
 }
 

@@ -89,6 +89,33 @@ TEST(Cli, StatsCountTheSamplesWhoseLightIsNotFinite) {
     EXPECT_NE(err.find("pixels have non-finite"), std::string::npos) << err;
 }
 
+TEST(Cli, ALightFacingAwayFromEverythingIsWarnedOf) {
+    // The light of kGood above the sphere with its edges swapped emits upwards, away from
+    // everything: the render is black, and says why (the file still written, exit 0). --stats
+    // counts the samples a light sample reached with light (lit_samples): none.
+    std::string dir = tempDir(), err;
+    writeFile(dir + "/away.json", scene(kSphere, "\"edge1\": [1, 0, 0], \"edge2\": [0, 0, 1]", "\"edge1\": [0, 0, 1], \"edge2\": [1, 0, 0]"));
+    writeFile(dir + "/good.json", scene(kSphere));
+    for (const char* method : {"mc", "aaf"}) {
+        EXPECT_EQ(runWedge(std::string("render ") + dir + "/away.json --method " + method + " --quiet -o " + dir + "/a.png --stats " + dir +
+                               "/s.json",
+                           nullptr, &err),
+                  0)
+            << err;
+        EXPECT_NE(err.find("away.json: no light reached any surface the camera sees"), std::string::npos) << err;
+        EXPECT_NE(err.find("swap the two"), std::string::npos) << err;
+        EXPECT_TRUE(fs::exists(dir + "/a.png"));
+        EXPECT_EQ(nlohmann::json::parse(readFile(dir + "/s.json")).value("lit_samples", -1.0), 0.0);
+        EXPECT_EQ(runWedge(std::string("render ") + dir + "/good.json --method " + method + " --quiet -o " + dir + "/b.png --stats " + dir +
+                               "/t.json",
+                           nullptr, &err),
+                  0)
+            << err;
+        EXPECT_EQ(err.find("no light reached"), std::string::npos) << err;
+        EXPECT_GT(nlohmann::json::parse(readFile(dir + "/t.json")).value("lit_samples", -1.0), 0.0);
+    }
+}
+
 TEST(Cli, TheExrFileIsTheSameOnAnyNumberOfThreads) {
     // OpenEXR compresses blocks of lines on its own thread pool; the file's bytes, not only the
     // image, must not depend on --threads.

@@ -52,6 +52,8 @@ void runRender(const RenderArgs& a) {
     if (!root) return;
     if (const size_t bad = render::nonFinitePixels(result); bad > 0)
         std::fprintf(stderr, "wedge: warning: %zu pixels have non-finite (NaN or infinite) samples or colour\n", bad);
+    if (const std::string unlit = render::unlitWarning(scene.desc(), result); !unlit.empty())
+        std::fprintf(stderr, "wedge: warning: %s: %s\n", a.scene.c_str(), unlit.c_str());
 
     for (const auto& o : a.outputs) render::writeOutput(result, o);
     if (!a.stats.empty()) writeJsonFile(a.stats, render::statsJson(result, a.scene));

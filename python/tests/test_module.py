@@ -101,6 +101,27 @@ def test_load_scene_dict_equals_the_file(monkeypatch):
         assert np.array_equal(a.buffers[name], b.buffers[name]), name
 
 
+def test_a_light_facing_away_from_everything_warns():
+    # A parallelogram emits towards edge1 x edge2: swapped, the light above a quad emits
+    # upwards, away from it, and the render is black and warns as `wedge render` does.
+    scene = {
+        "camera": {"position": [0, 1, 3], "look_at": [0, 0, 0], "up": [0, 1, 0], "fov_y": 40, "resolution": [8, 8]},
+        "materials": {"white": {"albedo": [0.8, 0.8, 0.8]}},
+        "lights": [{"type": "parallelogram", "corner": [-0.5, 2, -0.5], "edge1": [0, 0, 1], "edge2": [1, 0, 0],
+                    "radiance": [5, 5, 5]}],
+        "objects": [{"type": "quad", "corner": [-2, 0, 2], "edge1": [4, 0, 0], "edge2": [0, 0, -4], "material": "white"}],
+    }
+    with pytest.warns(UserWarning, match="no light reached any surface"):
+        r = render(wedge.load_scene(scene), method="mc")
+    assert r.stats["lit_samples"] == 0 and not np.any(r.color)
+    scene["lights"][0]["edge1"], scene["lights"][0]["edge2"] = [1, 0, 0], [0, 0, 1]
+    import warnings
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        r = render(wedge.load_scene(scene), method="mc")
+    assert r.stats["lit_samples"] > 0 and np.all(r.color.mean(axis=(0, 1)) > 0)
+
+
 def test_load_scene_takes_a_path_object():
     path = SOURCE_DIR / "scenes" / "cornell" / "cornell.json"
     assert wedge.load_scene(path).resolution == wedge.load_scene("cornell").resolution

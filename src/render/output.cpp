@@ -38,6 +38,13 @@ void writeOutput(const RenderResult& r, const std::string& path) {
     io::writeExr(path, r.color.width(), r.color.height(), exrChannels(r));
 }
 
+std::string unlitWarning(const scene::SceneDesc& desc, const RenderResult& result) {
+    if (desc.lights.empty() || result.figure("lit_samples").value_or(1.0) != 0.0) return {};
+    return "no light reached any surface the camera sees, nor any they see (the image is black but for emitters): "
+           "does every light face away? A parallelogram or triangle emits towards edge1 x edge2 only; swap the two to "
+           "turn it round";
+}
+
 size_t nonFinitePixels(const RenderResult& r) {
     const FrameBuffers& b = r.buffers;
     auto sampled = [&](size_t p) {  // the planes that sum samples' light

@@ -23,6 +23,11 @@ nlohmann::json statsJson(const RenderResult& result, const std::string& sceneNam
 /// colour is NaN or infinite: every pixel with a non-finite sample, and every pixel a filter made
 /// non-finite. A correct render has none; the count makes one that has them visible.
 size_t nonFinitePixels(const RenderResult& result);
+/// Where a scene has lights but no light sample reached any surface with light (--stats
+/// lit_samples 0: every light faces away from what the camera sees and what that sees), what
+/// to say about its black image; empty otherwise. `wedge render` prints it as a warning, the
+/// Python module raises it as one.
+std::string unlitWarning(const scene::SceneDesc& desc, const RenderResult& result);
 std::string timingSummary(const RenderResult& result);
 
 }  // namespace wedge::render

@@ -240,7 +240,7 @@ void PathSampler::traceMany(const SampleRun* runs, size_t nRuns, bool span) cons
     Wave& w = *scratch;
     size_t r = 0;
     uint32_t done = 0;  // samples of runs[r] already traced
-    uint64_t bad = 0;
+    uint64_t bad = 0, lit = 0;
     while (r < nRuns) {
         // Camera rays and primary hits, one pixel's batch of up to 16 at a time, and each hit's
         // light sample, until the wave is full.
@@ -331,6 +331,7 @@ void PathSampler::traceMany(const SampleRun* runs, size_t nRuns, bool span) cons
                 o.record.light = m_group[ls.light];
                 o.record.lightPoint = ls.point;
                 if (maxComponent(ls.irradiance) <= 0) continue;
+                ++lit;
                 o.record.unoccluded = luminance(ls.irradiance) * kInvPi;
                 o.shadowTested = true;
                 o.d1 = length(m_groupCenter[o.record.light] - hit.position);
@@ -393,6 +394,7 @@ void PathSampler::traceMany(const SampleRun* runs, size_t nRuns, bool span) cons
                 const LightSample& l2 = w.l2[j] =
                     sampleLight(h2.position, facing(h2.shadingNormal, g2), w.uBounceLight[l], w.choice[l]);
                 if (maxComponent(l2.irradiance) <= 0 || dot(l2.toLight, g2) <= 0) continue;
+                ++lit;
                 w.pushShadow(j, offset(h2.position, g2), l2.point, w.time[l]);
                 ++o.rays;
             }
@@ -413,6 +415,7 @@ void PathSampler::traceMany(const SampleRun* runs, size_t nRuns, bool span) cons
         }
     }
     if (bad > 0) m_nonFinite.fetch_add(bad, std::memory_order_relaxed);
+    if (lit > 0) m_lit.fetch_add(lit, std::memory_order_relaxed);
 }
 
 Vec3f PathSampler::meanEmission(int x, int y, uint32_t count) const {

@@ -113,6 +113,10 @@ public:
     /// finite: a scene's extreme numbers overflowing a float on the way. There should be none;
     /// --stats reports them (nonfinite_samples) beside the pixels they reach.
     uint64_t nonFiniteSamples() const { return m_nonFinite.load(std::memory_order_relaxed); }
+    /// The samples traced so far that a light sample reached with light, before visibility (at
+    /// their hit, or at their bounce's): none in a scene whose lights all face away from what
+    /// the camera sees and what it sees lights, which renders black but for its emitters.
+    uint64_t litSamples() const { return m_lit.load(std::memory_order_relaxed); }
     const scene::Scene& scene() const { return m_scene; }
     /// Appends every ray traceBatch asks Embree for to `log` (null: none), by kind. One thread
     /// only: for the throughput benchmark, never in a render.
@@ -156,6 +160,7 @@ private:
     float m_epsilon;
     bool m_needChoice;  // light choice or shutter time vary
     mutable std::atomic<uint64_t> m_nonFinite{0};
+    mutable std::atomic<uint64_t> m_lit{0};
     std::vector<float> m_lightCdf;     // light choice proportional to power
     std::vector<Vec3f> m_lightNormal;  // each light's normal() and area(), once (sampleLight's hot loop)
     std::vector<float> m_lightArea;

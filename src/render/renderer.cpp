@@ -406,6 +406,9 @@ RenderResult render(const scene::Scene& scene, const RenderOptions& options) {
     uint64_t nonFinite = 0;
     for (uint64_t n : gatherCounts(sampler.distribution(), sampler.nonFiniteSamples())) nonFinite += n;
     result.extra.emplace_back("nonfinite_samples", double(nonFinite));
+    uint64_t lit = 0;
+    for (uint64_t n : gatherCounts(sampler.distribution(), sampler.litSamples())) lit += n;
+    result.extra.emplace_back("lit_samples", double(lit));
     result.seconds.add("total", total.seconds());
     shareRootTimes(sampler.distribution(), result.seconds);  // every rank returns the same result
     return result;
