@@ -319,7 +319,7 @@ void PathSampler::traceMany(const SampleRun* runs, size_t nRuns, bool span) cons
                     if (o.bend > LightFieldSamples::kBentPath) {
                         // The normal at the open and at the close (Embree's is the hit's time's),
                         // against the direction to the camera then.
-                        const Vec3f n0 = m ? rotate(w.geometric[l], m->axis, -m->radians * t) : w.geometric[l];
+                        const Vec3f n0 = m ? m->turn(w.geometric[l], -t) : w.geometric[l];
                         const Vec3f n1 = m ? m->turn(n0, 1.f) : n0;
                         const Vec3f v0 = normalize(m_camera.poseAt(0.f).position - atOpen);
                         const Vec3f v1 = normalize(m_camera.poseAt(1.f).position - atClose);
