@@ -36,6 +36,10 @@ static_assert(sizeof(Gathered) == 52, "the bin fits in what was padding");
 /// A layer whose slopes spread less than this (pixels per unit lens coordinate) is sheared with
 /// its mean slope alone; a wider one's rays take the slope of the surface they find.
 constexpr float kSlopeSpread = 0.25f;
+/// A blurred moving layer whose samples all move at most this far along one grid axis (pixels
+/// over the shutter), with every slope within kCrispSlope, keeps that axis crisp (Layer::crisp;
+/// LayerOptions::crispAcrossMotion).
+constexpr float kCrispMotion = 0.25f, kCrispSlope = 1.5f;
 /// A sample's screen motion counts as motion above this (pixels over the shutter).
 constexpr float kMoving = 0.5f;
 /// A tile's moving samples fall in at most this many groups of like motion, each split into
@@ -136,6 +140,8 @@ constexpr Shaped kSegmentShape[16] = {
 /// The grid's own blur without its Gaussian, variance per axis (pixels^2): the cells a sample is
 /// splatted into (1/12) and the bilinear lookup (1/6).
 constexpr float kCellBlur = 1.f / 12.f + 1.f / 6.f;
+/// ... the cells' alone: the blur across a crisp layer's motion (Layer::crisp).
+constexpr float kCellOnly = 1.f / 12.f;
 /// Whether a layer of mean slope c, slopes spreading over `spread` and mean screen motion `motion`
 /// (pixels) is sharp: its true blur, a disc of radius |c| (c^2 / 4 per axis) and a segment of
 /// length |m| (m^2 / 12), below the grid's own with the smallest Gaussian.
@@ -268,6 +274,9 @@ struct Layer {
     // cornell).
     float rayC = 0, rayC2 = 0, rayMx = 0, rayMy = 0, rayT2 = 0;
     float gridBlur = 0;  // the grid's own blur, variance per axis (pixels^2)
+    // ... what the lens shear is shaped for: gridBlur, or across a crisp layer's motion its cells'
+    // alone (1/12: no Gaussian, and the lookup the nearest cell).
+    float lensBlur = 0;
     // A blurred moving layer's rays are sheared by motionScale times the screen motion of the
     // surface they find there (motionGrid: per cell the mean motion of the layer's samples,
     // smoothed; where it has none, the affine fit of its samples' motion to their position, so
@@ -288,8 +297,8 @@ struct Layer {
     bool followsSlope() const { return cMax - cMin >= kSlopeSpread; }
     /// The shaped lens shear (A, B) of the slope c.
     Shaped shear(float c) const {
-        if (sqr(c) <= 4.f * gridBlur) return {};
-        const Shaped k = shaped(std::sqrt(gridBlur) / std::abs(c), kDiscShape, 0.025f, 0.5f);
+        if (sqr(c) <= 4.f * lensBlur) return {};
+        const Shaped k = shaped(std::sqrt(lensBlur) / std::abs(c), kDiscShape, 0.025f, 0.5f);
         return {c * k.a, c * k.b};
     }
     void buildShearTable() {
@@ -303,6 +312,12 @@ struct Layer {
     // The Gaussians of the sharp image (layers.h, step 2): sigma for the radiance and the motion,
     // sigmaCoverage (<= sigma) for N, D and the slope, whose grid blur the rays' shear is shaped for.
     float sigma = 0, sigmaCoverage = 0;
+    // A blurred moving layer whose samples move along one grid axis only (and are in focus) keeps
+    // the other axis crisp: no Gaussian across the motion, and its lookup there the nearest
+    // cell, the pixel's own row (column) of samples (-1: neither; 0: x crisp; 1: y).
+    int crisp = -1;
+    float sigmaX(float s) const { return crisp == 0 ? 0.f : s; }
+    float sigmaY(float s) const { return crisp == 1 ? 0.f : s; }
     int timeBins = 1;
     // The grid: cell (i, j) covers the pixel [gx0 + i, gx0 + i + 1) x [gy0 + j, gy0 + j + 1).
     // (Half-pixel cells blur less but are noisier: AAF relMSE on conference at 512x512 0.000625
@@ -858,11 +873,16 @@ void splitLayers(Samples& g, const SlopeRange (&range)[kClasses], const float (&
 /// time (the common runs, a still layer's and a moving one's: the loops over channels unrolled
 /// and vectorised; the same sums in the same order, so the same bytes as the general loop).
 template <int kChannels>
-void smoothRun(std::vector<float>& acc, int gw, int gh, int stride, float sigma, int c0, int c1) {
+void smoothRun(std::vector<float>& acc, int gw, int gh, int stride, float sigma, float sigmaY, int c0, int c1) {
     const int n = kChannels > 0 ? kChannels : c1 - c0;
-    const int r = int(std::ceil(3.f * sigma));
-    std::vector<float> w(2 * r + 1);
-    for (int k = -r; k <= r; ++k) w[k + r] = std::exp(-0.5f * float(k * k) / (sigma * sigma));
+    auto weights = [](float sg) {
+        const int r = sg > 0.f ? int(std::ceil(3.f * sg)) : 0;
+        std::vector<float> w(2 * r + 1, 1.f);
+        for (int k = -r; k <= r && r > 0; ++k) w[k + r] = std::exp(-0.5f * float(k * k) / (sg * sg));
+        return w;
+    };
+    const std::vector<float> w = weights(sigma), wy = weights(sigmaY);
+    const int r = int(w.size() / 2), ry = int(wy.size() / 2);
     const size_t cells = size_t(gw) * gh;
     std::vector<float> tmp(cells * n, 0.f);
     // Per row, the columns [lo, hi) the horizontal pass can make non-zero: within r of its cells
@@ -896,27 +916,27 @@ void smoothRun(std::vector<float>& acc, int gw, int gh, int stride, float sigma,
         }
     for (size_t q = 0; q < cells; ++q) std::fill_n(&acc[q * stride + c0], n, 0.f);
     for (int j = 0; j < gh; ++j)
-        for (int k = std::max(-r, -j); k <= std::min(r, gh - 1 - j); ++k) {
+        for (int k = std::max(-ry, -j); k <= std::min(ry, gh - 1 - j); ++k) {
             const int i0 = lo[size_t(j + k)], i1 = hi[size_t(j + k)];
             if (i0 >= i1) continue;
-            const float wk = w[k + r];
+            const float wk = wy[k + ry];
             const float* in = &tmp[size_t(j + k) * gw * n];
             float* out = &acc[size_t(j) * gw * stride + c0];
             for (int i = i0; i < i1; ++i)
                 for (int ch = 0; ch < n; ++ch) out[size_t(i) * stride + ch] += wk * in[size_t(i) * n + ch];
         }
 }
-void smooth(std::vector<float>& acc, int gw, int gh, int stride, float sigma, int c0 = 0, int c1 = -1) {
+void smooth(std::vector<float>& acc, int gw, int gh, int stride, float sigma, float sigmaY, int c0 = 0, int c1 = -1) {
     if (c1 < 0) c1 = stride;
     switch (c1 - c0) {
-        case 1: return smoothRun<1>(acc, gw, gh, stride, sigma, c0, c1);
-        case 2: return smoothRun<2>(acc, gw, gh, stride, sigma, c0, c1);
-        case 3: return smoothRun<3>(acc, gw, gh, stride, sigma, c0, c1);
-        case 4: return smoothRun<4>(acc, gw, gh, stride, sigma, c0, c1);
-        case 6: return smoothRun<6>(acc, gw, gh, stride, sigma, c0, c1);
-        case 4 * kTimeBins: return smoothRun<4 * kTimeBins>(acc, gw, gh, stride, sigma, c0, c1);  // a moving layer's W, R, G, B per time bin
-        case 2 + 4 * kTimeBins: return smoothRun<2 + 4 * kTimeBins>(acc, gw, gh, stride, sigma, c0, c1);  // ... with N and the slopes
-        default: return smoothRun<0>(acc, gw, gh, stride, sigma, c0, c1);
+        case 1: return smoothRun<1>(acc, gw, gh, stride, sigma, sigmaY, c0, c1);
+        case 2: return smoothRun<2>(acc, gw, gh, stride, sigma, sigmaY, c0, c1);
+        case 3: return smoothRun<3>(acc, gw, gh, stride, sigma, sigmaY, c0, c1);
+        case 4: return smoothRun<4>(acc, gw, gh, stride, sigma, sigmaY, c0, c1);
+        case 6: return smoothRun<6>(acc, gw, gh, stride, sigma, sigmaY, c0, c1);
+        case 4 * kTimeBins: return smoothRun<4 * kTimeBins>(acc, gw, gh, stride, sigma, sigmaY, c0, c1);  // a moving layer's W, R, G, B per time bin
+        case 2 + 4 * kTimeBins: return smoothRun<2 + 4 * kTimeBins>(acc, gw, gh, stride, sigma, sigmaY, c0, c1);  // ... with N and the slopes
+        default: return smoothRun<0>(acc, gw, gh, stride, sigma, sigmaY, c0, c1);
     }
 }
 
@@ -1047,7 +1067,8 @@ struct Lookup {
     Vec3f premultiplied{0.f};
 };
 /// The bilinear cells and weights of a blurred layer's lookup at sharp-image position p: between
-/// cell centres (at +1/2).
+/// cell centres (at +1/2); along a crisp axis (Layer::crisp) the cell that holds p (weights 0
+/// and 1).
 struct Bilinear {
     int cell[4];
     float w[4];
@@ -1058,8 +1079,10 @@ struct Bilinear {
 [[gnu::always_inline]] inline int minValue(int a, int b) { return b < a ? b : a; }
 [[gnu::always_inline]] inline int maxValue(int a, int b) { return a < b ? b : a; }
 [[gnu::always_inline]] inline Bilinear bilinear(const Layer& l, Vec2f p) {
-    const float fx = clampValue(p.x - float(l.gx0) - 0.5f, 0.f, float(l.gw - 1));
-    const float fy = clampValue(p.y - float(l.gy0) - 0.5f, 0.f, float(l.gh - 1));
+    const float fx = l.crisp == 0 ? clampValue(std::floor(p.x - float(l.gx0)), 0.f, float(l.gw - 1))
+                                  : clampValue(p.x - float(l.gx0) - 0.5f, 0.f, float(l.gw - 1));
+    const float fy = l.crisp == 1 ? clampValue(std::floor(p.y - float(l.gy0)), 0.f, float(l.gh - 1))
+                                  : clampValue(p.y - float(l.gy0) - 0.5f, 0.f, float(l.gh - 1));
     const int i0 = minValue(int(fx), std::max(0, l.gw - 2)), j0 = minValue(int(fy), std::max(0, l.gh - 2));
     const float ax = fx - float(i0), ay = fy - float(j0);
     // A blurred layer's grid is at least 7 cells a side (its tile and a margin of at least
@@ -1824,7 +1847,7 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                         // pixels' error is made of").
                         l.sigmaCoverage = std::clamp(o.sigmaScale * std::abs(l.c), std::min(o.sigmaCoverageMin, o.sigmaMin), l.sigma);
                         const float gridBlur = kCellBlur + sqr(l.sigmaCoverage);
-                        l.gridBlur = gridBlur;
+                        l.gridBlur = l.lensBlur = gridBlur;
                         if (l.followsSlope()) l.buildShearTable();
                         if (0.25f * sqr(l.c) >= gridBlur) {
                             const Shaped sh = l.shear(l.c);
@@ -1871,6 +1894,42 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                     int cellIndex(Vec2f p) const { return gridCell(gx0, gy0, gw, gh, p); }
                     bool inFrontOfAll(float q, float t) const { return moving && inFrontOfMoving(invDepthMax, depthRate, q, t); }
                 };
+                if (o.crispAcrossMotion && anyMotionGrid) {
+                    // Which axis each blurred moving layer in focus keeps crisp (Layer::crisp): the
+                    // largest motion of its samples along each axis.
+                    std::vector<std::array<float, 2>> most(layers.size(), {-1.f, -1.f});
+                    for (size_t k = 0; k < layers.size(); ++k) {
+                        const Layer& l = layers[k];
+                        if (!motionAcc[k].empty() && std::max(std::abs(l.cMin), std::abs(l.cMax)) <= kCrispSlope) most[k] = {0.f, 0.f};
+                    }
+                    for (const Gathered& s : g) {
+                        std::array<float, 2>& m = most[size_t(split.layerOf(s))];
+                        if (m[0] < 0.f) continue;
+                        m[0] = std::max(m[0], std::abs(s.mx));
+                        m[1] = std::max(m[1], std::abs(s.my));
+                    }
+                    for (size_t k = 0; k < layers.size(); ++k) {
+                        Layer& l = layers[k];
+                        const std::array<float, 2>& m = most[k];
+                        if (m[0] < 0.f) continue;
+                        l.crisp = m[1] <= kCrispMotion ? 1 : m[0] <= kCrispMotion ? 0 : -1;
+                        if (l.crisp < 0) continue;
+                        // Across the motion the grid blurs by its cells alone (1/12 per axis), so
+                        // the rays carry the lens's disc but for that; along it the grid's whole
+                        // blur, and the motion's shaping leaves to it what the lens shear does not
+                        // carry: the true variance c^2 / 4 + m^2 / 12 is the grid's, the disc's
+                        // c^2 / 4 - 1/12 (or nothing, below it) and the shaped segment's.
+                        l.lensBlur = kCellOnly;
+                        const Shaped lens = l.shear(l.c);
+                        l.rayC = lens.a, l.rayC2 = lens.b;
+                        if (l.followsSlope()) l.buildShearTable();
+                        const float rest = l.gridBlur - std::min(0.25f * sqr(l.c), kCellOnly);
+                        const Shaped sh = shaped(std::sqrt(rest) / l.motionRms, kSegmentShape, 0.02f, 0.288675f);
+                        l.rayMx = l.mx * sh.a, l.rayMy = l.my * sh.a;
+                        l.motionScale = sh.a;
+                        l.rayT2 = sh.a > 0 ? sh.b / sh.a : 0.f;
+                    }
+                }
                 std::vector<SplatTarget> target(layers.size());
                 for (size_t k = 0; k < layers.size(); ++k) {
                     Layer& l = layers[k];
@@ -2005,7 +2064,7 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                         const AffineMotion fit = fitMotion(motionAcc[k], l.gw, l.gh, Vec2f{l.mx, l.my});
                         l.motionFit = fit;
                         l.motionFit.centre = {fit.centre.x + float(l.gx0), fit.centre.y + float(l.gy0)};
-                        smooth(motionAcc[k], l.gw, l.gh, 3, l.sigma);
+                        smooth(motionAcc[k], l.gw, l.gh, 3, l.sigmaX(l.sigma), l.sigmaY(l.sigma));
                         l.motionGrid.resize(size_t(l.gw) * l.gh * 2);
                         const size_t cells = size_t(l.gw) * l.gh;
                         float deviation = 0;  // the largest |cell's motion - the fit's mean| where there are samples
@@ -2131,13 +2190,14 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                 }
                 for (Layer& l : layers) {
                     if (!l.sharp) {
-                        if (l.sigmaCoverage == l.sigma) {
-                            smooth(l.acc, l.gw, l.gh, l.accStride(), l.sigma);
+                        const float sc = l.sigmaCoverage, sr = l.sigma;
+                        if (sc == sr) {
+                            smooth(l.acc, l.gw, l.gh, l.accStride(), l.sigmaX(sr), l.sigmaY(sr));
                         } else {
-                            smooth(l.acc, l.gw, l.gh, l.accStride(), l.sigmaCoverage, 0, 2);  // N, the slopes
-                            smooth(l.acc, l.gw, l.gh, l.accStride(), l.sigma, 2);           // W, R, G, B
+                            smooth(l.acc, l.gw, l.gh, l.accStride(), l.sigmaX(sc), l.sigmaY(sc), 0, 2);  // N, the slopes
+                            smooth(l.acc, l.gw, l.gh, l.accStride(), l.sigmaX(sr), l.sigmaY(sr), 2);     // W, R, G, B
                         }
-                        smooth(l.accD, l.gw, l.gh, 1, l.sigmaCoverage);
+                        smooth(l.accD, l.gw, l.gh, 1, l.sigmaX(sc), l.sigmaY(sc));
                     }
                     resolveCells(l, l.sharp ? 0.5f : 0.05f);
                     l.acc = std::vector<float>();

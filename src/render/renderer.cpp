@@ -235,6 +235,10 @@ Image3f reconstructFromLayers(const MethodContext& ctx,
     // 0.94-1.19x, 1.06x on their geometric mean, à-trous's 0.93-1.07x, MC's 0.90-1.02x, 0.96x;
     // docs/layers.md, "More rays where a layer moves").
     const bool ownRadiance = std::all_of(surfaceLight.begin(), surfaceLight.end(), [](const Image3f* l) { return l == nullptr; });
+    // Across a layer's motion, where it moves along one axis, filtered light keeps the layer's
+    // grid crisp: there the grid's Gaussian trades a blur for noise the filters have already
+    // removed (LayerOptions::crispAcrossMotion; docs/layers.md, "Crisp across the motion").
+    lo.crispAcrossMotion = !ownRadiance;
     if (ownRadiance) {
         const double perPixel = double(ctx.lightField->samples()) / double(std::max<size_t>(1, size_t(fb.width) * fb.height));
         lo.sharpShare = float(std::clamp(std::sqrt(perPixel / 64.0), 0.5, 1.0));
