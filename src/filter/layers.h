@@ -42,8 +42,8 @@
 //    "sharp": not reprojected, its grid its pixels' own samples (for samples that carry their
 //    own radiance, below half the grid's own at 16 samples per pixel: LayerOptions::sharpShare).
 //    Where the samples carry filtered light, a moving layer in focus whose samples move along
-//    one axis of the grid keeps the other axis crisp: no Gaussian across the motion and the
-//    nearest cell there (LayerOptions::crispAcrossMotion).
+//    one axis of the grid keeps the other axis crisp: the nearest cell there, and across the
+//    motion no Gaussian but the radiance's, stopped at edges (LayerOptions::crispAcrossMotion).
 // 3. Each pixel is the mean of 32 reconstruction rays (x, y, u, v, t), a 5D Kronecker sequence
 //    shifted per pixel, so that pixel, lens and shutter are stratified jointly. Front to back, a
 //    ray takes each layer's alpha and premultiplied radiance at its shear, with the slope and
@@ -125,14 +125,14 @@ struct LayerOptions {
     // Layers.TheDsSkippedFarFromALayersOwnSamplesChangeNoImage).
     bool countEveryD = false;
     // A blurred moving layer whose samples move along one axis of the grid, in focus (slopes
-    // within 1.5 px), keeps the other axis crisp: no Gaussian across the motion, and the rays'
-    // lookup there the nearest cell, the pixel's own row (column) of samples, with the rays
-    // carrying the whole lens shear. The grid's blur across a motion, about 0.7 px (sigma) with
-    // its cells, Gaussian and bilinear lookup, spread a moving box's lit top face, a strip 1-2
-    // px tall, into the wall above it and the box below (docs/moving-boxes.json). Off by
-    // default: the renderer sets it where the samples carry filtered light, whose noise the
-    // Gaussian no longer needs to average (samples with their own radiance measured worse
-    // without it: MC relMSE on raster-pan +32%; docs/layers.md, "Crisp across the motion").
+    // within 1.5 px), keeps the other axis crisp: the rays' lookup there the nearest cell, the
+    // pixel's own row (column) of samples, no Gaussian across the motion for the coverage, the
+    // radiance's stopped at edges, and the rays carrying the lens's disc but for the cells'
+    // blur. The grid's blur across a motion, about 0.7 px (sigma) with its cells, Gaussian and
+    // bilinear lookup, spread a moving box's lit top face, a strip 1-2 px tall, into the wall
+    // above it and the box below (docs/moving-boxes.json). Off by default: the renderer sets it
+    // where the samples carry filtered light (samples with their own radiance measured worse
+    // with it: MC relMSE on raster-pan +12%; docs/layers.md, "Crisp across the motion").
     bool crispAcrossMotion = false;
 };
 

@@ -236,7 +236,7 @@ Image3f reconstructFromLayers(const MethodContext& ctx,
     // docs/layers.md, "More rays where a layer moves").
     const bool ownRadiance = std::all_of(surfaceLight.begin(), surfaceLight.end(), [](const Image3f* l) { return l == nullptr; });
     // Across a layer's motion, where it moves along one axis, filtered light keeps the layer's
-    // grid crisp: there the grid's Gaussian trades a blur for noise the filters have already
+    // grid crisp: there the grid's blur trades sharpness for noise the filters have mostly
     // removed (LayerOptions::crispAcrossMotion; docs/layers.md, "Crisp across the motion").
     lo.crispAcrossMotion = !ownRadiance;
     if (ownRadiance) {
