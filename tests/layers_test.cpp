@@ -1305,12 +1305,10 @@ TEST(Layers, AThinLitStripOnALayerMovingAlongItStaysSharpAcrossTheMotion) {
     // motion (the Gaussian there stopped at the strip's edges), the rows (columns) are nearly
     // their own samples'. Motion along x, then along y. Under a pinhole the RMS near the strip
     // falls from 0.0199 and 0.0227 to 0.0099 and 0.0113 (the trail's noise). With the box 0.6 px
-    // out of focus, 0.0212 and 0.0234 -> 0.0091 and 0.0113; at 1.2 px, where the disc is wider
-    // than the grid's blur, 0.0149 and 0.0142 -> 0.0138 and 0.0140: a wash, within the samples'
-    // noise (the sanitizers' build measured 0.0134 against 0.0131), so there the test asks only
-    // that it be no worse beyond that. There the rays carry the lens's disc but for the cells'
-    // blur (kCellOnly); before the edge-stopping Gaussian, the whole disc measured 0.0148 and
-    // 0.0146, none of it 0.0142 and 0.0158, against 0.0132 and 0.0133 shaped.
+    // out of focus, 0.0212 and 0.0234 -> 0.0091 and 0.0113, the rays carrying the lens's disc but
+    // for the cells' blur (kCellOnly). At 1.2 px, past kCrispSlope, the layer keeps the old grid
+    // (0.0149 and 0.0142 either way; crisp, with the limit at 1.5 px, a wash within the samples'
+    // noise: 0.0138 and 0.0140, and in the sanitizers' build 0.0134 against 0.0131).
     struct Case {
         float slope;
         double bound, share;  // the crisp RMS below `bound` and below `share` times the blurred one

@@ -38,8 +38,11 @@ static_assert(sizeof(Gathered) == 52, "the bin fits in what was padding");
 constexpr float kSlopeSpread = 0.25f;
 /// A blurred moving layer whose samples all move at most this far along one grid axis (pixels
 /// over the shutter), with every slope within kCrispSlope, keeps that axis crisp (Layer::crisp;
-/// LayerOptions::crispAcrossMotion).
-constexpr float kCrispMotion = 0.25f, kCrispSlope = 1.5f;
+/// LayerOptions::crispAcrossMotion). (kCrispSlope 1.5 measured AAF relMSE +5% and +4% on the
+/// held-out camera pans docs/sponza-pan.json and sponza-campan.json, where 0.75 measured +3% and
+/// +2% and 0.5 +1% and +0.5%; below 0.75 docs/moving-boxes.json lost all of its gain, its box's
+/// slopes reaching 0.7 px: docs/layers.md, "Crisp across the motion".)
+constexpr float kCrispMotion = 0.25f, kCrispSlope = 0.75f;
 /// Across a crisp layer's motion its radiance's Gaussian stops at edges: where two cells'
 /// radiance differs by this share of their mean, the weight falls by e^(-1/2) (smoothAcrossEdges).
 /// (AAF relMSE, with a first version of the pass, at 0.1 / 0.3 / 0.6 / 1.2: docs/motion.json
