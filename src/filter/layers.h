@@ -125,7 +125,7 @@ struct LayerOptions {
     // Layers.TheDsSkippedFarFromALayersOwnSamplesChangeNoImage).
     bool countEveryD = false;
     // A blurred moving layer whose samples move along one axis of the grid, in focus (slopes
-    // within 1.5 px), keeps the other axis crisp: the rays' lookup there the nearest cell, the
+    // within 0.75 px), keeps the other axis crisp: the rays' lookup there the nearest cell, the
     // pixel's own row (column) of samples, no Gaussian across the motion for the coverage, the
     // radiance's stopped at edges, and the rays carrying the lens's disc but for the cells'
     // blur. The grid's blur across a motion, about 0.7 px (sigma) with its cells, Gaussian and
