@@ -311,6 +311,22 @@ struct Layer {
         const Shaped k = shaped(std::sqrt(lensBlur) / std::abs(c), kDiscShape, 0.025f, 0.5f);
         return {c * k.a, c * k.b};
     }
+    /// The rays' lens and shutter shear for the grid's blur (gridBlur, lensBlur): the lens's
+    /// disc shaped for lensBlur (none where the disc is within it), and the motion's segment
+    /// for what of the grid's blur the lens shear does not carry, so that the second moments
+    /// add up to the true c^2 / 4 + m^2 / 12: the grid's, the shaped disc's c^2 / 4 - lensBlur
+    /// (or nothing, below it) and the shaped segment's (none where the grid's blur alone
+    /// reaches it). `motion`: the layer's RMS screen motion (pixels).
+    void shapeRays(float motion) {
+        if (followsSlope()) buildShearTable();
+        const Shaped lens = shear(c);
+        rayC = lens.a, rayC2 = lens.b;
+        const float rest = gridBlur - std::min(0.25f * sqr(c), lensBlur);
+        const Shaped k = motion > 0 ? shaped(std::sqrt(rest) / motion, kSegmentShape, 0.02f, 0.288675f) : Shaped{};
+        rayMx = mx * k.a, rayMy = my * k.a;
+        motionScale = k.a;
+        rayT2 = k.a > 0 ? k.b / k.a : 0.f;
+    }
     void buildShearTable() {
         const float step = (cMax - cMin) / float(kShearSteps);
         shearFrom = cMin;
@@ -879,20 +895,23 @@ void splitLayers(Samples& g, const SlopeRange (&range)[kClasses], const float (&
     }
 }
 
-/// Separable Gaussian of `sigma` cells over channels [c0, c1) of the `stride` interleaved
-/// channels of `acc` (gw x gh); c1 < 0: to the last. kChannels > 0: c1 - c0 known at compile
+/// A Gaussian's taps exp(-k^2 / (2 sigma^2)), k = -r..r with r = ceil(3 sigma); the one tap 1
+/// for sigma 0 (no smoothing).
+std::vector<float> gaussianTaps(float sigma) {
+    const int r = sigma > 0.f ? int(std::ceil(3.f * sigma)) : 0;
+    std::vector<float> w(2 * r + 1, 1.f);
+    for (int k = -r; k <= r && r > 0; ++k) w[k + r] = std::exp(-0.5f * float(k * k) / (sigma * sigma));
+    return w;
+}
+
+/// Separable Gaussian of `sigma` cells along x and `sigmaY` along y (0: none) over channels
+/// [c0, c1) of the `stride` interleaved channels of `acc` (gw x gh); c1 < 0: to the last. kChannels > 0: c1 - c0 known at compile
 /// time (the common runs, a still layer's and a moving one's: the loops over channels unrolled
 /// and vectorised; the same sums in the same order, so the same bytes as the general loop).
 template <int kChannels>
 void smoothRun(std::vector<float>& acc, int gw, int gh, int stride, float sigma, float sigmaY, int c0, int c1) {
     const int n = kChannels > 0 ? kChannels : c1 - c0;
-    auto weights = [](float sg) {
-        const int r = sg > 0.f ? int(std::ceil(3.f * sg)) : 0;
-        std::vector<float> w(2 * r + 1, 1.f);
-        for (int k = -r; k <= r && r > 0; ++k) w[k + r] = std::exp(-0.5f * float(k * k) / (sg * sg));
-        return w;
-    };
-    const std::vector<float> w = weights(sigma), wy = weights(sigmaY);
+    const std::vector<float> w = gaussianTaps(sigma), wy = gaussianTaps(sigmaY);
     const int r = int(w.size() / 2), ry = int(wy.size() / 2);
     const size_t cells = size_t(gw) * gh;
     std::vector<float> tmp(cells * n, 0.f);
@@ -960,7 +979,9 @@ void smooth(std::vector<float>& acc, int gw, int gh, int stride, float sigma, fl
 /// inside its trail: AAF relMSE docs/motion.json +3%, many-motion +4%, à-trous +11% and +3%;
 /// with the plain Gaussian a lit strip's edge blurs. docs/layers.md, "Crisp across the motion".)
 void smoothAcrossEdges(std::vector<float>& acc, int gw, int gh, int stride, int c0, float sigma, int axis) {
-    const int n = stride - c0, r = int(std::ceil(3.f * sigma));
+    const int n = stride - c0;
+    const std::vector<float> taps = gaussianTaps(sigma);
+    const int r = int(taps.size() / 2);
     const size_t cells = size_t(gw) * gh;
     std::vector<float> luminance(cells, -1.f);  // -1: no weight (the cell adds nothing)
     for (size_t q = 0; q < cells; ++q) {
@@ -969,8 +990,6 @@ void smoothAcrossEdges(std::vector<float>& acc, int gw, int gh, int stride, int 
         for (int b = 0; b < n / 4; ++b) w += a[4 * b], v += a[4 * b + 1] + a[4 * b + 2] + a[4 * b + 3];
         if (w > 0.f) luminance[q] = v / w;
     }
-    std::vector<float> gauss(size_t(r) + 1);
-    for (int k = 0; k <= r; ++k) gauss[size_t(k)] = std::exp(-0.5f * float(k * k) / (sigma * sigma));
     std::vector<float> out(cells * n, 0.f);
     const int len = axis == 1 ? gh : gw, step = axis == 1 ? gw : 1;
     // Each pair of cells once (its weight is symmetric), from the lower one; a cell without
@@ -986,7 +1005,7 @@ void smoothAcrossEdges(std::vector<float>& acc, int gw, int gh, int stride, int 
             const size_t e = q + size_t(k) * size_t(step);
             const bool hasE = luminance[e] >= 0.f;
             if (!hasQ && !hasE) continue;
-            float w = gauss[size_t(k)];
+            float w = taps[size_t(r + k)];
             if (hasQ && hasE) {
                 const float d = (luminance[q] - luminance[e]) / (kCrispEdge * (0.5f * (luminance[q] + luminance[e]) + 0.01f));
                 w *= std::exp(-0.5f * d * d);
@@ -1907,19 +1926,7 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                         l.sigmaCoverage = std::clamp(o.sigmaScale * std::abs(l.c), std::min(o.sigmaCoverageMin, o.sigmaMin), l.sigma);
                         const float gridBlur = kCellBlur + sqr(l.sigmaCoverage);
                         l.gridBlur = l.lensBlur = gridBlur;
-                        if (l.followsSlope()) l.buildShearTable();
-                        if (0.25f * sqr(l.c) >= gridBlur) {
-                            const Shaped sh = l.shear(l.c);
-                            l.rayC = sh.a, l.rayC2 = sh.b;
-                        } else {
-                            l.rayC = 0;
-                            const float rest = gridBlur - 0.25f * sqr(l.c);
-                            const Shaped k = motion > 0 ? shaped(std::sqrt(rest) / motion, kSegmentShape, 0.02f, 0.288675f) : Shaped{};
-                            l.rayMx = l.mx * k.a;
-                            l.rayMy = l.my * k.a;
-                            l.motionScale = k.a;
-                            l.rayT2 = k.a > 0 ? k.b / k.a : 0.f;
-                        }
+                        l.shapeRays(motion);
                         lm = int(std::ceil(gridReach)) + 1;  // (at most maxGridMargin: above)
                         anyBlurred = true;
                     }
@@ -1975,18 +1982,9 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                         if (l.crisp < 0) continue;
                         // Across the motion the grid blurs by its cells alone (1/12 per axis), so
                         // the rays carry the lens's disc but for that; along it the grid's whole
-                        // blur, and the motion's shaping leaves to it what the lens shear does not
-                        // carry: the true variance c^2 / 4 + m^2 / 12 is the grid's, the disc's
-                        // c^2 / 4 - 1/12 (or nothing, below it) and the shaped segment's.
+                        // blur, which the motion's shaping counts.
                         l.lensBlur = kCellOnly;
-                        const Shaped lens = l.shear(l.c);
-                        l.rayC = lens.a, l.rayC2 = lens.b;
-                        if (l.followsSlope()) l.buildShearTable();
-                        const float rest = l.gridBlur - std::min(0.25f * sqr(l.c), kCellOnly);
-                        const Shaped sh = shaped(std::sqrt(rest) / l.motionRms, kSegmentShape, 0.02f, 0.288675f);
-                        l.rayMx = l.mx * sh.a, l.rayMy = l.my * sh.a;
-                        l.motionScale = sh.a;
-                        l.rayT2 = sh.a > 0 ? sh.b / sh.a : 0.f;
+                        l.shapeRays(l.motionRms);
                     }
                 }
                 std::vector<SplatTarget> target(layers.size());
