@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <numeric>
 
 #include "core/error.h"
 #include "core/parallel.h"
@@ -406,13 +407,14 @@ RenderResult render(const scene::Scene& scene, const RenderOptions& options) {
     result.raysPerRank = gatherCounts(sampler.distribution(), result.rays);
     result.rays = 0;
     for (uint64_t r : result.raysPerRank) result.rays += r;
-    // And the samples whose light is not finite (--stats nonfinite_samples), over every rank.
-    uint64_t nonFinite = 0;
-    for (uint64_t n : gatherCounts(sampler.distribution(), sampler.nonFiniteSamples())) nonFinite += n;
-    result.extra.emplace_back("nonfinite_samples", double(nonFinite));
-    uint64_t lit = 0;
-    for (uint64_t n : gatherCounts(sampler.distribution(), sampler.litSamples())) lit += n;
-    result.extra.emplace_back("lit_samples", double(lit));
+    // And, over every rank, the samples whose light is not finite (--stats nonfinite_samples) and
+    // those a light sample reached with light (lit_samples).
+    auto overRanks = [&](uint64_t mine) {
+        const std::vector<uint64_t> all = gatherCounts(sampler.distribution(), mine);
+        return double(std::accumulate(all.begin(), all.end(), uint64_t{0}));
+    };
+    result.extra.emplace_back("nonfinite_samples", overRanks(sampler.nonFiniteSamples()));
+    result.extra.emplace_back("lit_samples", overRanks(sampler.litSamples()));
     result.seconds.add("total", total.seconds());
     shareRootTimes(sampler.distribution(), result.seconds);  // every rank returns the same result
     return result;
