@@ -1317,6 +1317,44 @@ TEST(Render, MaafIsAafWhereNoFilterHasOuterComponents) {
     EXPECT_NE(0, std::memcmp(outer.color.data(), aaf.color.data(), aaf.color.size() * sizeof(Vec3f)));
 }
 
+TEST(Render, MaafUsesTheCentralComponentOnAMovingSurface) {
+    // MAAF's analysis has no time axis: a pixel whose primary surface moves over the shutter
+    // takes the central component alone (MaafOptions::movingObjects). kPlankUnderLens with all
+    // components everywhere (as above: most pixels use outer components while it is still).
+    // With both objects moving, no pixel has outer components and the image and samples are
+    // AAF's bit for bit; with the plank alone moving, the still floor keeps its outer components.
+    const std::string moving = kPlankUnderLens;
+    const std::string grey = R"("material": "grey"})", red = R"("material": "red"})";
+    auto withVelocity = [](std::string text, const std::string& object, const char* velocity) {
+        const size_t at = text.find(object);
+        EXPECT_NE(at, std::string::npos);
+        return text.replace(at, object.size(), object.substr(0, object.size() - 1) + R"(, "velocity": )" + velocity + "}");
+    };
+    const std::string plankMoves = withVelocity(moving, red, "[0.2, 0, 0]");
+    const std::string bothMove = withVelocity(plankMoves, grey, "[0.05, 0, 0]");
+    render::RenderOptions o;
+    o.quiet = true;
+    o.maafComponents = 5;
+    o.maafFit = false;
+    {
+        const scene::Scene scene(parse(bothMove));
+        o.method = "aaf";
+        const render::RenderResult aaf = render::render(scene, o);
+        o.method = "maaf";
+        const render::RenderResult maaf = render::render(scene, o);
+        EXPECT_EQ(maaf.figure("maaf_outer_component_pixels").value_or(-1), 0.0);
+        EXPECT_EQ(maaf.rays, aaf.rays);
+        ASSERT_EQ(maaf.color.size(), aaf.color.size());
+        EXPECT_EQ(0, std::memcmp(maaf.color.data(), aaf.color.data(), aaf.color.size() * sizeof(Vec3f)));
+    }
+    const scene::Scene still(parse(kPlankUnderLens)), plank(parse(plankMoves));
+    o.method = "maaf";
+    const double outerStill = render::render(still, o).figure("maaf_outer_component_pixels").value_or(-1);
+    const double outerFloor = render::render(plank, o).figure("maaf_outer_component_pixels").value_or(-1);
+    EXPECT_GT(outerStill, 0.5 * 32 * 32);
+    EXPECT_GT(outerFloor, 0.9 * outerStill);  // (the floor is most of the image)
+}
+
 namespace {
 /// MAAF's render options at `spp` initial samples and `seed`, without progress output.
 render::RenderOptions quietMaaf(int spp, uint32_t seed) {

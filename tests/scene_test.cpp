@@ -361,6 +361,28 @@ TEST(Scene, AMovingMeshBesideAStillOneIsFoundByEveryQuery) {
             EXPECT_EQ(h->motion ? h->motion->displacement : Vec3f(0.f), cases[i].material == 1 ? Vec3f(2, 0, 0) : Vec3f(0.f));
         }
         EXPECT_EQ(one.object, cases[i].material == 1 ? 1u : 0u) << "each mesh its own object";
+        ASSERT_LT(one.object, s.objectMoves().size());
+        EXPECT_EQ(s.objectMoves()[one.object], cases[i].material == 1) << "which objects move (MAAF's central-only rule)";
+    }
+    EXPECT_EQ(s.objectMoves().size(), 2u);
+}
+
+TEST(Scene, ObjectMovesNamesTheMovingSpheresByTheirHitsObject) {
+    // Spheres follow the meshes in the object ids (Hit::object); objectMoves() says which move.
+    SceneDesc d;
+    d.materials.push_back({"a", Vec3f(0.5f), Vec3f(0.f), "", 1.f, nullptr});
+    d.lights.push_back({{-0.5f, -0.5f, 5}, {1, 0, 0}, {0, -1, 0}, Vec3f(1.f)});
+    TriangleMesh floor;
+    appendQuad(floor, {-3.f, -3.f, -2.f}, {6, 0, 0}, {0, 6, 0}, 0);
+    d.meshes.push_back(floor);
+    d.spheres.push_back({{-1.f, 0.f, 0.f}, 0.5f, 0, Vec3f(0.f)});
+    d.spheres.push_back({{1.f, 0.f, 0.f}, 0.5f, 0, Vec3f(0.f, 1.f, 0.f)});
+    Scene s(std::move(d));
+    ASSERT_EQ(s.objectMoves(), (std::vector<uint8_t>{0, 0, 1}));
+    for (const auto& [x, object] : {std::pair{-1.f, 1u}, std::pair{1.f, 2u}, std::pair{0.f, 0u}}) {
+        Hit h;
+        ASSERT_TRUE(s.intersect({x, 0, 5}, {0, 0, -1}, 0, kInf, 0.f, h));
+        EXPECT_EQ(h.object, object);
     }
 }
 

@@ -176,9 +176,13 @@ MaafEffect::MaafEffect(const Image<MaafPixel>& params)
 
 namespace {
 
-/// Whether pixel p uses the central component only because of the focal plane (MaafParams::fallback).
-bool focalFallback(const FrameBuffers& fb, const WedgeField& wf, bool lens, const MaafOptions& o, size_t p) {
-    return fb.object[p] >= 0 && o.focalFallback && lens && (wf.focalStraddle[p] > 0 || (wf.suMin[p] < 0 && wf.suMax[p] > 0));
+/// Whether pixel p uses the central component only (MaafParams::fallback): at the focal plane,
+/// or where its primary surface moves over the shutter (MaafOptions::movingObjects).
+bool centralOnly(const FrameBuffers& fb, const WedgeField& wf, bool lens, const MaafOptions& o, size_t p) {
+    if (fb.object[p] < 0) return false;
+    const size_t object = size_t(fb.object[p]);
+    if (object < o.movingObjects.size() && o.movingObjects[object]) return true;
+    return o.focalFallback && lens && (wf.focalStraddle[p] > 0 || (wf.suMin[p] < 0 && wf.suMax[p] > 0));
 }
 
 /// Whether pixel p (footprint d) has no indirect outer components for its nearest bounce hit:
@@ -280,7 +284,7 @@ Image<uint8_t> maafDirectOuter(const FrameBuffers& fb, const WedgeField& wf, con
             // What needs no frame first: no surface, no shadow wedge, the focal plane, slopes
             // that disagree (directInputs would make it central).
             if (fb.object[p] < 0 || !(wf.s2[p] < kInf) || (agree && !(*agree)[p])) continue;
-            const bool fallback = focalFallback(fb, wf, lens, o, p);
+            const bool fallback = centralOnly(fb, wf, lens, o, p);
             if (fallback) continue;
             const AxisFrame frame = directFrame(fb, view, p);
             for (int k = 0; k < 2 && !outer[p]; ++k) {
@@ -303,7 +307,7 @@ Image<uint8_t> maafIndirectOuter(const FrameBuffers& fb, const WedgeField& wf, c
             const size_t p = size_t(y) * W + x;
             // What needs no frame first: no surface, no bounce hit, the focal plane, a near hit.
             if (fb.object[p] < 0 || !(wf.zMin[p] < kInf)) continue;
-            const bool fallback = focalFallback(fb, wf, lens, o, p);
+            const bool fallback = centralOnly(fb, wf, lens, o, p);
             const float d = std::max(fb.footprint[p], 1e-12f);
             if (fallback || nearBounce(wf, o, p, d)) continue;
             // K >= 3 needs spatialScale Omega_x R step / 3 >= 3 (maafFitPairs) with Omega_x at most
@@ -360,7 +364,7 @@ MaafParams maafParams(const FrameBuffers& fb, const WedgeField& wf, const Filter
     parallelRows(H, [&](int y) {
         for (int x = 0; x < W; ++x) {
             size_t p = size_t(y) * W + x;
-            fallback[p] = focalFallback(fb, wf, lens, o, p) ? 1.f : 0.f;
+            fallback[p] = centralOnly(fb, wf, lens, o, p) ? 1.f : 0.f;
         }
     });
     // The planes the components read that the renderer rewrites after adaptive sampling are

@@ -77,6 +77,9 @@ void renderMaaf(const MethodContext& ctx, RenderResult& result) {
     // -0.3%; cornell-sphere -2.6% / -1.9% / -0.9% and -4.0% / -0.6% / +0.1%; conference -0.8% /
     // -0.8% / -0.3% and -2.8% / -1.8% / -0.9%. The paper's pipeline keeps every pixel's.
     mo.outerMinBounce = ctx.options.maafPaperRates ? 0.f : 0.5f;
+    // A moving surface's pixels use the central component only (in the paper's pipeline too: the
+    // paper has no motion); MaafOptions::movingObjects.
+    mo.movingObjects = ctx.scene.objectMoves();
     // Without outer components the direct light's filter is AAF's (below): no MAAF widths for it.
     mo.directEffect = mo.shadowComponents;
     if (mo.maxRadius < 1 || mo.maxRadius > filter::kMaafMaxWindowRadius)

@@ -128,6 +128,7 @@ Scene::Scene(SceneDesc desc) : m_desc(std::move(desc)) {
         uint32_t shapes = 0;
         for (uint32_t sId : mesh.shapeIds) shapes = std::max(shapes, sId + 1);
         object += std::max(shapes, 1u);
+        m_objectMoves.resize(object, uint8_t(moving));
     }
 
     if (!m_desc.spheres.empty()) {
@@ -157,6 +158,7 @@ Scene::Scene(SceneDesc desc) : m_desc(std::move(desc)) {
         m_geometry[id] = {m_sphereMaterials.data(), nullptr, 0, object, true};
         m_geometry[id].moves = moving;
         object += uint32_t(m_desc.spheres.size());
+        for (auto& s : m_desc.spheres) m_objectMoves.push_back(s.velocity * shutter != Vec3f(0.f));
     }
     rtcCommitScene(m_scene);
     if (rtcGetDeviceError(m_device) != RTC_ERROR_NONE) throw Error("Embree: failed to build the scene");

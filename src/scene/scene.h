@@ -84,6 +84,9 @@ public:
     float extent() const { return m_extent; }
     Vec3f boundsMin() const { return m_lo; }
     Vec3f boundsMax() const { return m_hi; }
+    /// By object id (Hit::object, FrameBuffers::object): 1 where that object moves or turns over
+    /// the shutter (the camera's motion aside).
+    const std::vector<uint8_t>& objectMoves() const { return m_objectMoves; }
 
     /// time in [0, 1] over the shutter.
     bool intersect(const Vec3f& org, const Vec3f& dir, float tNear, float tFar, float time, Hit& hit) const;
@@ -131,6 +134,7 @@ private:
     std::vector<RTCScene> m_moving;        // each moving mesh's own scene, instanced in m_scene
     std::vector<uint32_t> m_sphereMaterials;
     std::vector<RigidMotion> m_sphereMotion;  // by primitive, where a sphere moves (else empty)
+    std::vector<uint8_t> m_objectMoves;       // objectMoves()
     Vec3f m_lo{kInf}, m_hi{-kInf};
     float m_extent = 1.f;
 };
