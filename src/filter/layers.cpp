@@ -48,8 +48,20 @@ constexpr float kCrispMotion = 0.25f, kCrispSlope = 0.75f;
 /// (AAF relMSE, with a first version of the pass, at 0.1 / 0.3 / 0.6 / 1.2: docs/motion.json
 /// 0.0000425 / 0.0000414 / 0.0000412 / 0.0000411, moving-boxes 0.000229 / 0.000228 / 0.000228 /
 /// 0.000249, raster-pan 0.000424 / 0.000421 / 0.000416 / 0.000414; a thin lit strip keeps its
-/// edge better at 0.3 than at 0.5: layers_test, Layers.AThinLitStrip...)
-constexpr float kCrispEdge = 0.3f;
+/// edge better at 0.3 than at 0.5: layers_test, Layers.AThinLitStrip...) With the Gaussian
+/// kCrispWidth times wider, 0.2: AAF relMSE against (width 1, 0.3), geometric means over seven
+/// motion scenes (moving-blinds, moving-boxes, motion, bunny-slats, many-motion,
+/// textured-motion, raster-pan), 0.15 / 0.2 / 0.3: width 2 0.986 / 0.985 / 0.991 (0.3: moving-blinds
+/// +3.8%), width 3 0.983 / 0.984 / 0.997 (0.3: moving-blinds +8.4%); width 1 at 0.15: 1.003.
+constexpr float kCrispEdge = 0.2f;
+/// The radiance's edge-stopping Gaussian across a crisp layer's motion is this times the
+/// layer's radiance sigma (Layer::sigma). Within a trail, whose rows each average their own
+/// samples along the motion, a wider one averages more rows: at 1 the rows' noise showed as faint
+/// streaks along the motion (docs/motion.json's sphere), fainter at 2. AAF relMSE at 2 (with
+/// kCrispEdge 0.2) against 1 (with 0.3): motion -4.9%, many-motion -1.7%, moving-blinds -1.9%,
+/// moving-boxes -1.1%, raster-pan -0.4%, and on the held-out camera pans sponza-pan -3.2% and
+/// sponza-campan -2.1%; no scene worse (docs/layers.md, "A wider Gaussian across the motion").
+constexpr float kCrispWidth = 2.f;
 /// A sample's screen motion counts as motion above this (pixels over the shutter).
 constexpr float kMoving = 0.5f;
 /// A tile's moving samples fall in at most this many groups of like motion, each split into
@@ -2255,7 +2267,7 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                             smooth(l.acc, l.gw, l.gh, l.accStride(), l.sigmaX(sr), l.sigmaY(sr), 2);     // W, R, G, B
                         }
                         smooth(l.accD, l.gw, l.gh, 1, l.sigmaX(sc), l.sigmaY(sc));
-                        if (l.crisp >= 0) smoothAcrossEdges(l.acc, l.gw, l.gh, l.accStride(), 2, sr, l.crisp);
+                        if (l.crisp >= 0) smoothAcrossEdges(l.acc, l.gw, l.gh, l.accStride(), 2, kCrispWidth * sr, l.crisp);
                     }
                     resolveCells(l, l.sharp ? 0.5f : 0.05f);
                     l.acc = std::vector<float>();
