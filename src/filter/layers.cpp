@@ -43,25 +43,6 @@ constexpr float kSlopeSpread = 0.25f;
 /// +2% and 0.5 +1% and +0.5%; below 0.75 docs/moving-boxes.json lost all of its gain, its box's
 /// slopes reaching 0.7 px: docs/layers.md, "Crisp across the motion".)
 constexpr float kCrispMotion = 0.25f, kCrispSlope = 0.75f;
-/// Across a crisp layer's motion its radiance's Gaussian stops at edges: where two cells'
-/// radiance differs by this share of their mean, the weight falls by e^(-1/2) (smoothAcrossEdges).
-/// (AAF relMSE, with a first version of the pass, at 0.1 / 0.3 / 0.6 / 1.2: docs/motion.json
-/// 0.0000425 / 0.0000414 / 0.0000412 / 0.0000411, moving-boxes 0.000229 / 0.000228 / 0.000228 /
-/// 0.000249, raster-pan 0.000424 / 0.000421 / 0.000416 / 0.000414; a thin lit strip keeps its
-/// edge better at 0.3 than at 0.5: layers_test, Layers.AThinLitStrip...) With the Gaussian
-/// kCrispWidth times wider, 0.2: AAF relMSE against (width 1, 0.3), geometric means over seven
-/// motion scenes (moving-blinds, moving-boxes, motion, bunny-slats, many-motion,
-/// textured-motion, raster-pan), 0.15 / 0.2 / 0.3: width 2 0.986 / 0.985 / 0.991 (0.3: moving-blinds
-/// +3.8%), width 3 0.983 / 0.984 / 0.997 (0.3: moving-blinds +8.4%); width 1 at 0.15: 1.003.
-constexpr float kCrispEdge = 0.2f;
-/// The radiance's edge-stopping Gaussian across a crisp layer's motion is this times the
-/// layer's radiance sigma (Layer::sigma). Within a trail, whose rows each average their own
-/// samples along the motion, a wider one averages more rows: at 1 the rows' noise showed as faint
-/// streaks along the motion (docs/motion.json's sphere), fainter at 2. AAF relMSE at 2 (with
-/// kCrispEdge 0.2) against 1 (with 0.3): motion -4.9%, many-motion -1.7%, moving-blinds -1.9%,
-/// moving-boxes -1.1%, raster-pan -0.4%, and on the held-out camera pans sponza-pan -3.2% and
-/// sponza-campan -2.1%; no scene worse (docs/layers.md, "A wider Gaussian across the motion").
-constexpr float kCrispWidth = 2.f;
 /// A sample's screen motion counts as motion above this (pixels over the shutter).
 constexpr float kMoving = 0.5f;
 /// A tile's moving samples fall in at most this many groups of like motion, each split into
@@ -982,15 +963,16 @@ void smooth(std::vector<float>& acc, int gw, int gh, int stride, float sigma, fl
     }
 }
 
-/// The radiance's Gaussian of `sigma` cells across a crisp layer's motion (along grid axis
-/// `axis`), over channels [c0, stride) (W, R, G, B per time bin), stopped at edges: neighbour k
-/// weighs exp(-k^2 / (2 sigma^2)) exp(-d^2 / 2), d the difference of the two cells' radiance
-/// (luminance over all time bins) relative to their mean, over kCrispEdge. The weight is
-/// symmetric and scales W with R, G, B, so a cell's radiance stays a weighted mean.
-/// (Without it, crisp, a moving object's samples that carry their own light were noisier
-/// inside its trail: AAF relMSE docs/motion.json +3%, many-motion +4%, à-trous +11% and +3%;
-/// with the plain Gaussian a lit strip's edge blurs. docs/layers.md, "Crisp across the motion".)
-void smoothAcrossEdges(std::vector<float>& acc, int gw, int gh, int stride, int c0, float sigma, int axis) {
+/// The radiance's edge-stopping Gaussian of `sigma` cells along grid axis `axis`, over channels
+/// [c0, stride) (W, R, G, B per time bin): neighbour k weighs exp(-k^2 / (2 sigma^2)) exp(-d^2 /
+/// 2), d the difference of the two cells' radiance (luminance over all time bins) relative to
+/// their mean, over `edge` (LayerOptions::movingEdge). The weight is symmetric and scales W with
+/// R, G, B, so a cell's radiance stays a weighted mean.
+/// (Without it across a crisp layer's motion, a moving object's samples that carry their own
+/// light were noisier inside its trail: AAF relMSE docs/motion.json +3%, many-motion +4%,
+/// à-trous +11% and +3%; with the plain Gaussian a lit strip's edge blurs. docs/layers.md,
+/// "Crisp across the motion".)
+void smoothAcrossEdges(std::vector<float>& acc, int gw, int gh, int stride, int c0, float sigma, int axis, float edge) {
     const int n = stride - c0;
     const std::vector<float> taps = gaussianTaps(sigma);
     const int r = int(taps.size() / 2);
@@ -1019,7 +1001,7 @@ void smoothAcrossEdges(std::vector<float>& acc, int gw, int gh, int stride, int 
             if (!hasQ && !hasE) continue;
             float w = taps[size_t(r + k)];
             if (hasQ && hasE) {
-                const float d = (luminance[q] - luminance[e]) / (kCrispEdge * (0.5f * (luminance[q] + luminance[e]) + 0.01f));
+                const float d = (luminance[q] - luminance[e]) / (edge * (0.5f * (luminance[q] + luminance[e]) + 0.01f));
                 w *= std::exp(-0.5f * d * d);
             }
             float* oe = &out[e * n];
@@ -2267,7 +2249,11 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                             smooth(l.acc, l.gw, l.gh, l.accStride(), l.sigmaX(sr), l.sigmaY(sr), 2);     // W, R, G, B
                         }
                         smooth(l.accD, l.gw, l.gh, 1, l.sigmaX(sc), l.sigmaY(sc));
-                        if (l.crisp >= 0) smoothAcrossEdges(l.acc, l.gw, l.gh, l.accStride(), 2, kCrispWidth * sr, l.crisp);
+                        // A moving layer's radiance, edge-stopped along both axes (across a crisp
+                        // layer's motion its only Gaussian; LayerOptions::movingEdgeWidth).
+                        if (l.moving && o.movingEdgeWidth > 0.f)
+                            for (int axis = 0; axis < 2; ++axis)
+                                smoothAcrossEdges(l.acc, l.gw, l.gh, l.accStride(), 2, o.movingEdgeWidth * sr, axis, o.movingEdge);
                     }
                     resolveCells(l, l.sharp ? 0.5f : 0.05f);
                     l.acc = std::vector<float>();
