@@ -966,7 +966,7 @@ void smooth(std::vector<float>& acc, int gw, int gh, int stride, float sigma, fl
 /// The radiance's edge-stopping Gaussian of `sigma` cells along grid axis `axis`, over channels
 /// [c0, stride) (W, R, G, B per time bin): neighbour k weighs exp(-k^2 / (2 sigma^2)) exp(-d^2 /
 /// 2), d the difference of the two cells' radiance (luminance over all time bins) relative to
-/// their mean, over `edge` (LayerOptions::movingEdge). The weight is symmetric and scales W with
+/// their mean, over `edge` (LayerOptions::edgeStop). The weight is symmetric and scales W with
 /// R, G, B, so a cell's radiance stays a weighted mean.
 /// (Without it across a crisp layer's motion, a moving object's samples that carry their own
 /// light were noisier inside its trail: AAF relMSE docs/motion.json +3%, many-motion +4%,
@@ -2249,11 +2249,11 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                             smooth(l.acc, l.gw, l.gh, l.accStride(), l.sigmaX(sr), l.sigmaY(sr), 2);     // W, R, G, B
                         }
                         smooth(l.accD, l.gw, l.gh, 1, l.sigmaX(sc), l.sigmaY(sc));
-                        // A moving layer's radiance, edge-stopped along both axes (across a crisp
-                        // layer's motion its only Gaussian; LayerOptions::movingEdgeWidth).
-                        if (l.moving && o.movingEdgeWidth > 0.f)
+                        // The radiance, edge-stopped along both axes (across a crisp layer's motion
+                        // its only Gaussian; LayerOptions::movingEdgeWidth, stillEdgeWidth).
+                        if (const float width = l.moving ? o.movingEdgeWidth : o.stillEdgeWidth; width > 0.f)
                             for (int axis = 0; axis < 2; ++axis)
-                                smoothAcrossEdges(l.acc, l.gw, l.gh, l.accStride(), 2, o.movingEdgeWidth * sr, axis, o.movingEdge);
+                                smoothAcrossEdges(l.acc, l.gw, l.gh, l.accStride(), 2, width * sr, axis, o.edgeStop);
                     }
                     resolveCells(l, l.sharp ? 0.5f : 0.05f);
                     l.acc = std::vector<float>();

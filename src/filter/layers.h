@@ -44,8 +44,8 @@
 //    Where the samples carry filtered light, a moving layer in focus whose samples move along
 //    one axis of the grid keeps the other axis crisp: the nearest cell there, and across the
 //    motion no Gaussian but the radiance's, stopped at edges (LayerOptions::crispAcrossMotion).
-//    Every blurred moving layer's radiance is smoothed to its edges along both axes
-//    (LayerOptions::movingEdgeWidth).
+//    Every blurred moving layer's radiance is smoothed to its edges along both axes, and for
+//    samples with their own radiance every blurred still layer's (LayerOptions::movingEdgeWidth).
 // 3. Each pixel is the mean of 32 reconstruction rays (x, y, u, v, t), a 5D Kronecker sequence
 //    shifted per pixel, so that pixel, lens and shutter are stratified jointly. Front to back, a
 //    ray takes each layer's alpha and premultiplied radiance at its shear, with the slope and
@@ -138,15 +138,18 @@ struct LayerOptions {
     bool crispAcrossMotion = false;
     // A blurred moving layer's radiance is also smoothed along both grid axes by a Gaussian of
     // movingEdgeWidth times its radiance's sigma that stops at edges: a neighbour's weight falls
-    // by e^(-1/2) where the two cells' luminance differs by movingEdge of their mean (across a
-    // crisp layer's motion it is the only Gaussian; 0: none). Along the motion the rays average
-    // a trail's samples; across it only the grid does, and at the radiance's own sigma (about
-    // 0.5 px) the rows' noise showed as streaks along the motion. The range is the samples'
-    // noise: the defaults are for filtered light, and where the samples carry their own
-    // radiance the renderer sets 4 and 0.2. Against the crisp axis's alone (2x, at 0.2), on 19
-    // scenes with motion: AAF relMSE +0.8% to -8.4%, à-trous +0.1% to -12.5%, MC -0% to -59%
-    // (the camera pans); docs/layers.md, "Moving layers' radiance, smoothed to its edges".
-    float movingEdgeWidth = 2.f, movingEdge = 0.15f;
+    // by e^(-1/2) where the two cells' luminance differs by edgeStop of their mean (across a
+    // crisp layer's motion it is the only Gaussian; 0: none); a blurred still layer's by one of
+    // stillEdgeWidth times. Along the motion the rays average a trail's samples; across it only
+    // the grid does, and at the radiance's own sigma (about 0.5 px) the rows' noise showed as
+    // streaks along the motion. The range is the samples' noise: the defaults are for filtered
+    // light, where a still layer's measured no better with it (à-trous conference +0.9%), and
+    // where the samples carry their own radiance the renderer sets 4, 4 and 0.2. Against the
+    // crisp axis's alone (2x, at 0.2), on 19 scenes with motion: AAF relMSE +0.8% to -8.4%,
+    // à-trous +0.1% to -12.5%, MC -0% to -59% (the camera pans); MC on the lens scenes -15% to
+    // -19% (docs/layers.md, "Moving layers' radiance, smoothed to its edges", "... and MC's
+    // defocused layers").
+    float movingEdgeWidth = 2.f, stillEdgeWidth = 0.f, edgeStop = 0.15f;
 };
 
 struct LayerInput {
