@@ -146,8 +146,8 @@ struct LayerOptions {
     // light, where a still layer's measured no better with it (à-trous conference +0.9%), and
     // where the samples carry their own radiance the renderer sets 4, 4 and 0.2. Against the
     // crisp axis's alone (2x, at 0.2), on 19 scenes with motion: AAF relMSE +0.8% to -8.4%,
-    // à-trous +0.1% to -12.5%, MC -0% to -59% (the camera pans); MC on the lens scenes -15% to
-    // -19% (docs/layers.md, "Moving layers' radiance, smoothed to its edges", "... and MC's
+    // à-trous +0.1% to -12.5%, MC -0% to -59% (the camera pans); MC on the five lens scenes -15% to
+    // -27% (docs/layers.md, "Moving layers' radiance, smoothed to its edges", "... and MC's
     // defocused layers").
     float movingEdgeWidth = 2.f, stillEdgeWidth = 0.f, edgeStop = 0.15f;
 };
