@@ -36,7 +36,7 @@ void addRenderFlags(CLI::App& cmd, RenderFlags& flags) {
 }
 
 void addMethodFlags(CLI::App& cmd, render::RenderOptions& r) {
-    cmd.add_option("--max-extra-spp", r.maxExtraSpp, "aaf/maaf: cap on adaptive samples per pixel (default 16; the papers use 100)")
+    cmd.add_option("--max-extra-spp", r.maxExtraSpp, "aaf/maaf: cap on the adaptive samples per pixel their rates ask for (default 16; the papers use 100; the top-ups of mixed pixels to 64 and of emitter edges are not capped)")
         ->check(numberIn(0, 1 << 16));
     cmd.add_option("--texture-spp", r.textureSpp,
                    "aaf/maaf/atrous: camera rays alone per pixel for the albedo where a pixel's samples saw a texture "
