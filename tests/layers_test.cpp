@@ -1370,9 +1370,9 @@ TEST(Layers, AMovingLayersNoiseIsSmoothedToItsEdges) {
         std::vector<int> countAt(5, 0);
         for (int y = 28; y < 68; ++y)
             for (int x = 32; x < 96; ++x) {
-                const double e = out(x, y).x - exact(x, y);
+                const double want = exact(x, y), e = out(x, y).x - want;
                 const float d = float(x - y) - c;  // the pixel centre's offset from the edge (along x)
-                if (std::abs(d) > 6.f) squaredFlat += e * e / sqr(exact(x, y)), ++flatPixels;
+                if (std::abs(d) > 6.f) squaredFlat += e * e / sqr(want), ++flatPixels;
                 if (std::abs(d) <= 2.f) errorAt[size_t(int(d) + 2)] += e, ++countAt[size_t(int(d) + 2)];
             }
         flat[k] = std::sqrt(squaredFlat / flatPixels);
