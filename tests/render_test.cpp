@@ -1466,6 +1466,47 @@ TEST(Render, MixedPixelsAreToppedUpByTheirRelativeVariance) {
     EXPECT_EQ(one.primary(), 0);
 }
 
+TEST(Render, MixedPixelsWhoseSurfacesAllMoveTakeFewerTopUps) {
+    // A row of pixels, each with the edge of the test above (78 samples wanted at tau 0.01, 48
+    // more) and a still miss, whose motion does not count. Their surface samples move 20 px
+    // along the row, but in pixel 3 only 1.5 px (tau x 0.75: no change), in pixel 20 one sample
+    // is still, and from pixel 25 on all are still but in pixel 30.
+    constexpr int W = 41;
+    ViewGeometry view;
+    view.focalPixels = 100;
+    render::PixelStatsImage stats(W, 1);
+    LightFieldSamples lf(W, 1);
+    {
+        render::LightFieldStage record(&lf, [](size_t) { return 17u; });
+        for (int x = 0; x < W; ++x)
+            for (int i = 0; i < 17; ++i) {
+                if (i == 16) {  // the miss, in the light field only
+                    record.record(x, 0, render::TracedSample{}, -1);
+                    continue;
+                }
+                render::TracedSample s = surfaceSample(i % 2, i % 2 ? 1.f : 0.05f);
+                s.motion = x == 3 ? Vec2f{1.5f, 0.f} : (x >= 25 && x != 30) || (x == 20 && i == 3) ? Vec2f{0.f, 0.f} : Vec2f{20.f, 0.f};
+                record.record(x, 0, s, stats(x, 0).add(s, view, false, stats.pool()));
+            }
+    }
+    ASSERT_EQ(stats(0, 0).mixedTopUp(render::kMixedTau, render::kMixedSpp), 48u);
+    const Image<uint32_t> pooled = render::mixedTopUps(stats, &lf, {});
+    // Pixel 10's trail (pixels 0-20) moves but for pixel 20: tau x 0.5 x 20 x 20 / 21, 8.2
+    // samples wanted, already 16.
+    EXPECT_EQ(pooled(10, 0), 0u);
+    EXPECT_EQ(pooled(3, 0), 48u);
+    EXPECT_EQ(pooled(20, 0), 48u);
+    EXPECT_EQ(pooled(27, 0), 48u);
+    // Pixel 30's trail (20-40) is mostly still: only 21-24 and itself pool (tau x 2.4).
+    EXPECT_GT(pooled(30, 0), 0u);
+    EXPECT_LT(pooled(30, 0), 48u);
+    Image<uint8_t> bent(W, 1);
+    bent(10, 0) = 1;  // a surface turning towards the camera near: aaf and maaf compose it themselves
+    EXPECT_EQ(render::mixedTopUps(stats, &lf, bent)(10, 0), 48u);
+    const Image<uint32_t> alone = render::mixedTopUps(stats, nullptr, {});  // --layers off
+    for (int x = 0; x < W; ++x) EXPECT_EQ(alone(x, 0), 48u);
+}
+
 TEST(Render, PixelStatsTakeFurtherSlotsOnlyForASecondSurface) {
     // One surface: no block from the pool, and slots 1.. read as empty. A second surface takes
     // one block, which the third shares; a fourth goes nowhere. Moving the image of statistics

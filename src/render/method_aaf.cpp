@@ -42,12 +42,13 @@ void renderAaf(const MethodContext& ctx, RenderResult& result) {
     filter::AafParams params = filter::aafParams(fb, wedges, view, ao);
     Image<uint32_t> extra(W, H);
     const Image<uint32_t> emitterExtra = emitterTopUps(stats, kEmitterEdgeSpp);
+    const Image<uint32_t> mixedExtra = mixedTopUps(stats, ctx.lightField, bentPixels(ctx), ctx.sampler.distribution());
     const Image<uint32_t> emitterEdges = emitterTopUps(stats, kEmitterEdgeRays);  // (denseEmission)
     uint64_t extraTotal = 0;
     for (size_t i = 0; i < extra.size(); ++i) {
         float need = std::max({params.sppDirect[i], params.sppIndirect[i], params.sppLens[i]});
         extra[i] = std::max(uint32_t(std::clamp(int(std::ceil(need)) - int(n0), 0, cap)),
-                            std::max(emitterExtra[i], stats[i].mixedTopUp(kMixedTau, kMixedSpp)));
+                            std::max(emitterExtra[i], mixedExtra[i]));
         extraTotal += extra[i];
     }
     result.seconds.add("prefilter", t.seconds());

@@ -235,6 +235,7 @@ void renderMaaf(const MethodContext& ctx, RenderResult& result) {
     const filter::AafParams rates = filter::aafParams(fb, wedges, view, ao);
     Image<uint32_t> extra(W, H);
     const Image<uint32_t> emitterExtra = emitterTopUps(stats, kEmitterEdgeSpp);
+    const Image<uint32_t> mixedExtra = mixedTopUps(stats, ctx.lightField, bentPixels(ctx), ctx.sampler.distribution());
     const Image<uint32_t> emitterEdges = emitterTopUps(stats, kEmitterEdgeRays);  // (denseEmission)
     uint64_t extraTotal = 0;
     // Whether an effect's filter at pixel p has outer components on either image axis.
@@ -251,7 +252,7 @@ void renderMaaf(const MethodContext& ctx, RenderResult& result) {
         const bool rated = !paper || params.fallback[i] > 0;
         const float need = rated ? std::max({rates.sppDirect[i], rates.sppIndirect[i], rates.sppLens[i]}) : 0.f;
         extra[i] = std::max(uint32_t(std::clamp(int(std::ceil(need)) - int(n0), 0, cap)),
-                            std::max(emitterExtra[i], stats[i].mixedTopUp(kMixedTau, kMixedSpp)));
+                            std::max(emitterExtra[i], mixedExtra[i]));
         extraTotal += extra[i];
     }
     result.seconds.add("prefilter_slopes", t.seconds());

@@ -75,6 +75,28 @@ uint64_t denseEmission(const MethodContext& ctx, const Image<uint32_t>& topUp, F
 /// cornell +20% / +25%, grids +3% / +1%.
 constexpr float kMixedTau = 0.01f;
 constexpr uint32_t kMixedSpp = 64;
+/// With a light field, a mixed pixel whose every surface sample moves on screen by at least m
+/// pixels is reconstructed by the layers from samples pooled along the motion, its neighbours'
+/// along the trail as well as its own: there tau is multiplied by kMotionPooling x m x the share
+/// of the trail's pixels (m / 2 either way) whose surface samples all move (when that is above
+/// 1), as if each pixel the motion crosses gave half a pixel's worth of samples. On a pan,
+/// where nearly every pixel mixes surfaces, the top-ups to 64 had made AAF's samples 3x MC's.
+/// AAF on nineteen scenes with motion, 1 / (relMSE x seconds) against tau alone: sponza-pan
+/// 1.28x, sponza-campan 1.24x, sponza-turn 1.16x, moving-boxes 1.08x, bunny-slats 0.96x (the
+/// one loss), 1.05x on the geometric mean of those that changed; 0.25 and 1 in place of 0.5
+/// measured 1.08x and 1.09x against 1.125x on eight of them (docs/layers.md, "Fewer top-ups
+/// where every surface moves").
+constexpr float kMotionPooling = 0.5f;
+/// The mixed pixels' top-ups of aaf and maaf (PixelStats::mixedTopUp at kMixedTau and
+/// kMixedSpp), with the light field's initial samples (or null) for kMotionPooling, except in
+/// the pixels `bent` marks (bentPixels; may be empty), which aaf and maaf compose themselves
+/// (`distribution`: every rank reads the other ranks' rows of the trail).
+Image<uint32_t> mixedTopUps(const PixelStatsImage& stats, const LightFieldSamples* lightField, const Image<uint8_t>& bent,
+                            const Distribution* distribution = nullptr);
+/// The pixels within reach of a sample whose path bends on a surface turning towards or away
+/// from the camera (LightFieldSamples::bentReach, every rank's rows), where aaf and maaf keep
+/// their own composition (result.methodPixels); empty where there are none or no light field.
+Image<uint8_t> bentPixels(const MethodContext& ctx);
 
 
 /// Texture samples, in every method that multiplies filtered light by albedo (aaf, maaf, atrous)

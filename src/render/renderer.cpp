@@ -55,6 +55,87 @@ Image<uint32_t> emitterTopUps(const PixelStatsImage& stats, uint32_t target) {
     return extra;
 }
 
+Image<uint8_t> bentPixels(const MethodContext& ctx) {
+    if (!ctx.lightField) return {};
+    LightFieldSamples& lf = *ctx.lightField;
+    const int W = lf.width(), H = lf.height();
+    // The squares around the bent samples' pixels, through a difference table: +1 and -1 at
+    // their corners, then sums along the rows and the columns.
+    exchangeImageRows(ctx.sampler.distribution(), lf.bentReachData(), W, H);
+    std::vector<int32_t> cover;
+    for (int y = 0; y < H; ++y)
+        for (int x = 0; x < W; ++x) {
+            const float reach = lf.bentReach(size_t(y) * W + x);
+            if (!(reach > 0.f)) continue;
+            if (cover.empty()) cover.assign(size_t(W + 1) * (H + 1), 0);
+            const int r = int(std::ceil(std::min(reach, float(W + H))));
+            const int x0 = std::max(0, x - r), x1 = std::min(W, x + r + 1), y0 = std::max(0, y - r), y1 = std::min(H, y + r + 1);
+            cover[size_t(y0) * (W + 1) + x0] += 1, cover[size_t(y0) * (W + 1) + x1] -= 1;
+            cover[size_t(y1) * (W + 1) + x0] -= 1, cover[size_t(y1) * (W + 1) + x1] += 1;
+        }
+    if (cover.empty()) return {};
+    for (int y = 0; y <= H; ++y)
+        for (int x = 1; x <= W; ++x) cover[size_t(y) * (W + 1) + x] += cover[size_t(y) * (W + 1) + x - 1];
+    for (int y = 1; y <= H; ++y)
+        for (int x = 0; x <= W; ++x) cover[size_t(y) * (W + 1) + x] += cover[size_t(y - 1) * (W + 1) + x];
+    Image<uint8_t> bent(W, H);
+    for (int y = 0; y < H; ++y)
+        for (int x = 0; x < W; ++x) bent(x, y) = cover[size_t(y) * (W + 1) + x] > 0;
+    return bent;
+}
+
+Image<uint32_t> mixedTopUps(const PixelStatsImage& stats, const LightFieldSamples* lightField, const Image<uint8_t>& bent,
+                            const Distribution* distribution) {
+    const int W = stats.width(), H = stats.height();
+    Image<uint32_t> extra(W, H);
+    // Each pixel's slowest surface sample's screen motion (pixels; 0 where none hit a
+    // surface), every rank's rows.
+    Image<Vec2f> slowest;
+    if (lightField) {
+        slowest = Image<Vec2f>(W, H);
+        parallelRows(H, [&](int y) {
+            for (int x = 0; x < W; ++x) {
+                int64_t least = -1;
+                Vec2f m{0.f, 0.f};
+                lightField->forEach(size_t(y) * W + x, [&](const LightFieldSample& l) {
+                    if (!(l.depth < kInf)) return;
+                    const int64_t m2 = int64_t(l.motionX) * l.motionX + int64_t(l.motionY) * l.motionY;
+                    if (least >= 0 && m2 >= least) return;
+                    least = m2;
+                    m = {float(l.motionX) / 8.f, float(l.motionY) / 8.f};
+                });
+                slowest(x, y) = m;
+            }
+        });
+        exchangeImageRows(distribution, slowest.data(), W, H);
+    }
+    parallelRows(H, [&](int y) {
+        for (int x = 0; x < W; ++x) {
+            const PixelStats& s = stats(x, y);
+            uint32_t add = s.mixedTopUp(kMixedTau, kMixedSpp);
+            const Vec2f m = lightField ? slowest(x, y) : Vec2f{0.f, 0.f};
+            const float length = std::sqrt(m.x * m.x + m.y * m.y);
+            if (add > 0 && kMotionPooling * length > 1.f && (bent.empty() || !bent(x, y))) {
+                // The pixels along the trail, half its length either way: the share of them
+                // whose samples all move (they pool too, where nothing still hides the trail).
+                const int reach = int(std::ceil(0.5f * length));
+                int moving = 0;
+                for (int k = -reach; k <= reach; ++k) {
+                    const int qx = int(std::lround(float(x) + float(k) * m.x / length));
+                    const int qy = int(std::lround(float(y) + float(k) * m.y / length));
+                    if (qx < 0 || qy < 0 || qx >= W || qy >= H) continue;
+                    const Vec2f q = slowest(qx, qy);
+                    if (q.x * q.x + q.y * q.y >= 1.f) ++moving;
+                }
+                const float pooled = kMotionPooling * length * float(moving) / float(2 * reach + 1);
+                if (pooled > 1.f) add = s.mixedTopUp(kMixedTau * pooled, kMixedSpp);
+            }
+            extra(x, y) = add;
+        }
+    });
+    return extra;
+}
+
 LightFieldStage adaptiveLightFieldStage(const MethodContext& ctx, const PixelStatsImage& stats, const Image<uint32_t>& emitterExtra,
                                         const Image<uint32_t>& extra) {
     if (!ctx.lightField) return LightFieldStage(nullptr, [](size_t) { return 0u; });
@@ -117,28 +198,9 @@ void leavePixelsToTheMethod(const MethodContext& ctx, const PixelStatsImage& sta
     exchangeImageRows(ctx.sampler.distribution(), mixed.data(), W, H);
     result.methodPixels = filter::pixelsAwayFromSilhouettes(mixed, filter::kSilhouetteReach);
 
-    // The squares around the bent samples' pixels, through a difference table: +1 and -1 at
-    // their corners, then sums along the rows and the columns.
-    exchangeImageRows(ctx.sampler.distribution(), lf.bentReachData(), W, H);
-    std::vector<int32_t> cover;
-    for (int y = 0; y < H; ++y)
-        for (int x = 0; x < W; ++x) {
-            const float reach = lf.bentReach(size_t(y) * W + x);
-            if (!(reach > 0.f)) continue;
-            if (cover.empty()) cover.assign(size_t(W + 1) * (H + 1), 0);
-            const int r = int(std::ceil(std::min(reach, float(W + H))));
-            const int x0 = std::max(0, x - r), x1 = std::min(W, x + r + 1), y0 = std::max(0, y - r), y1 = std::min(H, y + r + 1);
-            cover[size_t(y0) * (W + 1) + x0] += 1, cover[size_t(y0) * (W + 1) + x1] -= 1;
-            cover[size_t(y1) * (W + 1) + x0] -= 1, cover[size_t(y1) * (W + 1) + x1] += 1;
-        }
-    if (cover.empty()) return;
-    for (int y = 0; y <= H; ++y)
-        for (int x = 1; x <= W; ++x) cover[size_t(y) * (W + 1) + x] += cover[size_t(y) * (W + 1) + x - 1];
-    for (int y = 1; y <= H; ++y)
-        for (int x = 0; x <= W; ++x) cover[size_t(y) * (W + 1) + x] += cover[size_t(y - 1) * (W + 1) + x];
-    for (int y = 0; y < H; ++y)
-        for (int x = 0; x < W; ++x)
-            if (cover[size_t(y) * (W + 1) + x] > 0) result.methodPixels[size_t(y) * W + x] = 1;
+    const Image<uint8_t> bent = bentPixels(ctx);
+    for (size_t p = 0; p < bent.size(); ++p)
+        if (bent[p]) result.methodPixels[p] = 1;
 }
 
 }  // namespace
