@@ -87,12 +87,15 @@ constexpr uint32_t kMixedSpp = 64;
 /// measured 1.08x and 1.09x against 1.125x on eight of them (docs/layers.md, "Fewer top-ups
 /// where every surface moves").
 constexpr float kMotionPooling = 0.5f;
-/// The mixed pixels' top-ups of aaf and maaf (PixelStats::mixedTopUp at kMixedTau and
-/// kMixedSpp), with the light field's initial samples (or null) for kMotionPooling, except in
-/// the pixels `bent` marks (bentPixels; may be empty), which aaf and maaf compose themselves
-/// (`distribution`: every rank reads the other ranks' rows of the trail).
-Image<uint32_t> mixedTopUps(const PixelStatsImage& stats, const LightFieldSamples* lightField, const Image<uint8_t>& bent,
-                            const Distribution* distribution = nullptr);
+/// Per pixel, the factor kMotionPooling gives its top-up's tau (1 where it gives none), from the
+/// light field's initial samples: not in the pixels `bent` marks (bentPixels; may be empty),
+/// which aaf and maaf compose themselves (`distribution`: every rank reads the other ranks' rows
+/// of the trail). Empty without a light field.
+Image<float> motionPooling(const PixelStatsImage& stats, const LightFieldSamples* lightField, const Image<uint8_t>& bent,
+                           const Distribution* distribution = nullptr);
+/// The mixed pixels' top-ups of aaf and maaf: PixelStats::mixedTopUp at kMixedTau times the
+/// pixel's `pooling` (motionPooling; empty: 1), up to kMixedSpp.
+Image<uint32_t> mixedTopUps(const PixelStatsImage& stats, const Image<float>& pooling);
 /// The pixels within reach of a sample whose path bends on a surface turning towards or away
 /// from the camera (LightFieldSamples::bentReach, every rank's rows), where aaf and maaf keep
 /// their own composition (result.methodPixels); empty where there are none or no light field.

@@ -84,38 +84,35 @@ Image<uint8_t> bentPixels(const MethodContext& ctx) {
     return bent;
 }
 
-Image<uint32_t> mixedTopUps(const PixelStatsImage& stats, const LightFieldSamples* lightField, const Image<uint8_t>& bent,
-                            const Distribution* distribution) {
+Image<float> motionPooling(const PixelStatsImage& stats, const LightFieldSamples* lightField, const Image<uint8_t>& bent,
+                           const Distribution* distribution) {
+    if (!lightField) return {};
     const int W = stats.width(), H = stats.height();
-    Image<uint32_t> extra(W, H);
     // Each pixel's slowest surface sample's screen motion (pixels; 0 where none hit a
     // surface), every rank's rows.
-    Image<Vec2f> slowest;
-    if (lightField) {
-        slowest = Image<Vec2f>(W, H);
-        parallelRows(H, [&](int y) {
-            for (int x = 0; x < W; ++x) {
-                int64_t least = -1;
-                Vec2f m{0.f, 0.f};
-                lightField->forEach(size_t(y) * W + x, [&](const LightFieldSample& l) {
-                    if (!(l.depth < kInf)) return;
-                    const int64_t m2 = int64_t(l.motionX) * l.motionX + int64_t(l.motionY) * l.motionY;
-                    if (least >= 0 && m2 >= least) return;
-                    least = m2;
-                    m = {float(l.motionX) / 8.f, float(l.motionY) / 8.f};
-                });
-                slowest(x, y) = m;
-            }
-        });
-        exchangeImageRows(distribution, slowest.data(), W, H);
-    }
+    Image<Vec2f> slowest(W, H);
     parallelRows(H, [&](int y) {
         for (int x = 0; x < W; ++x) {
-            const PixelStats& s = stats(x, y);
-            uint32_t add = s.mixedTopUp(kMixedTau, kMixedSpp);
-            const Vec2f m = lightField ? slowest(x, y) : Vec2f{0.f, 0.f};
+            int64_t least = -1;
+            Vec2f m{0.f, 0.f};
+            lightField->forEach(size_t(y) * W + x, [&](const LightFieldSample& l) {
+                if (!(l.depth < kInf)) return;
+                const int64_t m2 = int64_t(l.motionX) * l.motionX + int64_t(l.motionY) * l.motionY;
+                if (least >= 0 && m2 >= least) return;
+                least = m2;
+                m = {float(l.motionX) / 8.f, float(l.motionY) / 8.f};
+            });
+            slowest(x, y) = m;
+        }
+    });
+    exchangeImageRows(distribution, slowest.data(), W, H);
+    Image<float> pooling(W, H);
+    parallelRows(H, [&](int y) {
+        for (int x = 0; x < W; ++x) {
+            const Vec2f m = slowest(x, y);
             const float length = std::sqrt(m.x * m.x + m.y * m.y);
-            if (add > 0 && kMotionPooling * length > 1.f && (bent.empty() || !bent(x, y))) {
+            float pooled = 1.f;
+            if (kMotionPooling * length > 1.f && (bent.empty() || !bent(x, y))) {
                 // The pixels along the trail, half its length either way: the share of them
                 // whose samples all move (they pool too, where nothing still hides the trail).
                 const int reach = int(std::ceil(0.5f * length));
@@ -127,11 +124,19 @@ Image<uint32_t> mixedTopUps(const PixelStatsImage& stats, const LightFieldSample
                     const Vec2f q = slowest(qx, qy);
                     if (q.x * q.x + q.y * q.y >= 1.f) ++moving;
                 }
-                const float pooled = kMotionPooling * length * float(moving) / float(2 * reach + 1);
-                if (pooled > 1.f) add = s.mixedTopUp(kMixedTau * pooled, kMixedSpp);
+                pooled = std::max(1.f, kMotionPooling * length * float(moving) / float(2 * reach + 1));
             }
-            extra(x, y) = add;
+            pooling(x, y) = pooled;
         }
+    });
+    return pooling;
+}
+
+Image<uint32_t> mixedTopUps(const PixelStatsImage& stats, const Image<float>& pooling) {
+    const int W = stats.width(), H = stats.height();
+    Image<uint32_t> extra(W, H);
+    parallelRows(H, [&](int y) {
+        for (int x = 0; x < W; ++x) extra(x, y) = stats(x, y).mixedTopUp(kMixedTau * (pooling.empty() ? 1.f : pooling(x, y)), kMixedSpp);
     });
     return extra;
 }
