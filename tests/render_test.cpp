@@ -1490,7 +1490,7 @@ TEST(Render, MixedPixelsWhoseSurfacesAllMoveTakeFewerTopUps) {
             }
     }
     ASSERT_EQ(stats(0, 0).mixedTopUp(render::kMixedTau, render::kMixedSpp), 48u);
-    const Image<uint32_t> pooled = render::mixedTopUps(stats, render::motionPooling(stats, &lf, {}));
+    const Image<uint32_t> pooled = render::mixedTopUps(stats, render::motionPooling(&lf, {}));
     // Pixel 10's trail (pixels 0-20) moves but for pixel 20: tau x 0.5 x 20 x 20 / 21, 8.2
     // samples wanted, already 16.
     EXPECT_EQ(pooled(10, 0), 0u);
@@ -1502,8 +1502,8 @@ TEST(Render, MixedPixelsWhoseSurfacesAllMoveTakeFewerTopUps) {
     EXPECT_LT(pooled(30, 0), 48u);
     Image<uint8_t> bent(W, 1);
     bent(10, 0) = 1;  // a surface turning towards the camera near: aaf and maaf compose it themselves
-    EXPECT_EQ(render::mixedTopUps(stats, render::motionPooling(stats, &lf, bent))(10, 0), 48u);
-    const Image<uint32_t> alone = render::mixedTopUps(stats, render::motionPooling(stats, nullptr, {}));  // --layers off
+    EXPECT_EQ(render::mixedTopUps(stats, render::motionPooling(&lf, bent))(10, 0), 48u);
+    const Image<uint32_t> alone = render::mixedTopUps(stats, render::motionPooling(nullptr, {}));  // --layers off
     for (int x = 0; x < W; ++x) EXPECT_EQ(alone(x, 0), 48u);
 }
 

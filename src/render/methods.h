@@ -91,8 +91,7 @@ constexpr float kMotionPooling = 0.5f;
 /// light field's initial samples: not in the pixels `bent` marks (bentPixels; may be empty),
 /// which aaf and maaf compose themselves (`distribution`: every rank reads the other ranks' rows
 /// of the trail). Empty without a light field.
-Image<float> motionPooling(const PixelStatsImage& stats, const LightFieldSamples* lightField, const Image<uint8_t>& bent,
-                           const Distribution* distribution = nullptr);
+Image<float> motionPooling(const LightFieldSamples* lightField, const Image<uint8_t>& bent, const Distribution* distribution = nullptr);
 /// The mixed pixels' top-ups of aaf and maaf: PixelStats::mixedTopUp at kMixedTau times the
 /// pixel's `pooling` (motionPooling; empty: 1), up to kMixedSpp.
 Image<uint32_t> mixedTopUps(const PixelStatsImage& stats, const Image<float>& pooling);

@@ -84,10 +84,9 @@ Image<uint8_t> bentPixels(const MethodContext& ctx) {
     return bent;
 }
 
-Image<float> motionPooling(const PixelStatsImage& stats, const LightFieldSamples* lightField, const Image<uint8_t>& bent,
-                           const Distribution* distribution) {
+Image<float> motionPooling(const LightFieldSamples* lightField, const Image<uint8_t>& bent, const Distribution* distribution) {
     if (!lightField) return {};
-    const int W = stats.width(), H = stats.height();
+    const int W = lightField->width(), H = lightField->height();
     // Each pixel's slowest surface sample's screen motion (pixels; 0 where none hit a
     // surface), every rank's rows.
     Image<Vec2f> slowest(W, H);
