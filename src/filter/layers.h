@@ -65,7 +65,8 @@
 //    the error (MC 16 spp on bunny at 512x512: the mixed pixels' relMSE 0.00136 -> 0.00121);
 //    to LayerOptions::movingRays in a tile where a layer moves, whose rays integrate over the
 //    shutter as well (the renderer: 128 where the samples carry filtered light, AAF relMSE
-//    3-19% lower on eight scenes with motion; docs/layers.md, "More rays where a layer moves").
+//    3-19% lower on eight scenes with motion; docs/layers.md, "More rays where a layer moves"),
+//    unless its first rays agree (LayerOptions::rayTolerance).
 //
 // The radiance a sample carries is its surface's light as the method filtered it (AAF's or
 // MAAF's filtered direct and indirect light of the sample's surface in its pixel, times the
@@ -120,6 +121,11 @@ struct LayerOptions {
     int rays = 32;      // reconstruction rays per pixel where a tile has a blurred layer (at most 128)
     int mixedRays = 64; // ... where the first `rays` straddle layers (at most 128)
     int movingRays = 128;  // ... and a layer of the tile moves (at most 128; the renderer keeps mixedRays for MC)
+    // ... but only where the first rays leave their mean uncertain: the variance of their
+    // luminance over the rays, divided by the number of rays and by the mean's square plus 0.01
+    // (relMSE's epsilon), at least this (0: every straddling pixel; docs/layers.md, "Extra rays
+    // only where the first ones disagree").
+    float rayTolerance = 1e-4f;
     uint32_t seed = 0;  // of the reconstruction rays
     // Count every sample's D on the grid of each layer in front of it, also where it lies farther
     // from all of that layer's own samples than can change the layer's coverage (the stage skips
@@ -200,7 +206,7 @@ struct LayerStats {
     double gatheredPerPixel = 0;  // samples a tile read, per pixel of the image
     double layersPerTile = 0;
     double blurredTiles = 0;      // fraction of tiles with a reprojected (blurred) layer
-    double straddlingPixels = 0;  // fraction of pixels whose first rays straddled layers (and took mixedRays)
+    double straddlingPixels = 0;  // fraction of pixels whose first rays straddled layers and disagreed (and took mixedRays)
     double multiRayPixels = 0;    // fraction of pixels that traced more than one reconstruction ray
     double raysPerPixel = 0;      // reconstruction rays traced, per pixel of the image
     double methodTiles = 0;       // fraction of tiles left whole to the method's own composition (LayerInput::methodPixels)
