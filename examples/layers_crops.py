@@ -7,6 +7,7 @@ crop's relMSE against the reference's crop.
     export PYTHONPATH=$PWD/build/python
     python3 examples/layers_crops.py --out docs/layers-crops.png     # 2 minutes on 2 cores
     python3 examples/layers_crops.py --set camera --out docs/layers-camera-and-turns.png   # 8 minutes
+    python3 examples/layers_crops.py --set order --out docs/layers-order.png   # 1 minute
 
 The crops are the rows of CROPS (scene, resolution, crop x, y, width, height); the
 reference is plain MC without layers with its own seed, so that its noise is independent of
@@ -43,7 +44,13 @@ CAMERA_CROPS = [
     ("bunny turning: its head and ears", os.path.join(HERE, "..", "docs", "bunny-turn.json"), (384, 384),
      100, 100, 160, 120),
 ]
-CROP_SETS = {"default": CROPS, "camera": CAMERA_CROPS}
+# --set order: a slat moving in front of the bunny's head while the bunny comes forward through the
+# slats' depth (docs/layers.md, "Two moving layers ordered where they meet").
+ORDER_CROPS = [
+    ("two moving layers: slats crossing the bunny's head", os.path.join(HERE, "..", "docs", "bunny-slats.json"), (256, 256),
+     95, 80, 90, 60),
+]
+CROP_SETS = {"default": CROPS, "camera": CAMERA_CROPS, "order": ORDER_CROPS}
 COLUMNS = [("mc", "off"), ("mc", "on"), ("aaf", "off"), ("aaf", "on")]
 
 
@@ -64,8 +71,9 @@ def main():
                    help="scale of every resolution and crop (default 1; the tests run 0.125)")
     p.add_argument("--out", default="layers-crops.png", help="output PNG (default layers-crops.png)")
     p.add_argument("--set", choices=sorted(CROP_SETS), default="default",
-                   help="the crops: a defocused silhouette, the focal plane and moving objects (default), or a "
-                        "moving camera, a turning camera and a turning object (camera)")
+                   help="the crops: a defocused silhouette, the focal plane and moving objects (default), a "
+                        "moving camera, a turning camera and a turning object (camera), or two moving layers "
+                        "crossing (order)")
     a = p.parse_args()
     if not 0 < a.scale <= 4:
         p.error("--scale: expected a number in (0, 4]")

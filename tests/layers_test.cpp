@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <random>
@@ -1110,6 +1111,58 @@ double rmsFromShutterAverage(const Image3f& out, ValueFn&& value) {
 }
 
 }  // namespace
+
+TEST(Layers, ALayerGoesBeforeTheFirstItMustPrecedePastLayersWithoutARule) {
+    // filter::orderLayers, four layers in splitLayers' order 0 1 2 3.
+    auto order = [](std::initializer_list<std::pair<int, int>> rules) {
+        uint8_t before[16] = {};
+        for (const auto& [first, second] : rules) before[first * 4 + second] = 1;
+        std::array<int, 4> o{};
+        filter::orderLayers(before, 4, o.data());
+        return o;
+    };
+    EXPECT_EQ(order({}), (std::array<int, 4>{0, 1, 2, 3}));
+    // 3 before 1, no rule against 2: 3 jumps 2 (an insertion that stopped at 2 kept 0 1 2 3).
+    EXPECT_EQ(order({{3, 1}}), (std::array<int, 4>{0, 3, 1, 2}));
+    EXPECT_EQ(order({{3, 1}, {2, 3}}), (std::array<int, 4>{0, 1, 2, 3}));  // ... but 2 before 3 too: they disagree, last
+    EXPECT_EQ(order({{3, 1}, {0, 3}}), (std::array<int, 4>{0, 3, 1, 2}));
+    EXPECT_EQ(order({{2, 0}, {3, 2}}), (std::array<int, 4>{3, 2, 0, 1}));
+    EXPECT_EQ(order({{1, 0}, {3, 0}, {1, 3}}), (std::array<int, 4>{1, 3, 0, 2}));
+}
+
+TEST(Layers, TwoMovingLayersAreOrderedWhereTheyMeet) {
+    // A pinhole, one 64-px tile. A lit block (radiance 1) moving 4 px down over the shutter, its
+    // top half at depth 5 and its bottom half coming forward from 4.6 to 3.6 (the bunny of
+    // docs/bunny-slats.json, whose chest passes the slats' depth while its head stays behind
+    // them); a dark band (0.05) 4 px high at depth 4.35 sliding 30 px sideways across the
+    // block's top half, in front of it all along; a still wall (0.25) at depth 10. By each
+    // layer's nearest sample in an order bin the block went before the band once its bottom
+    // half came nearer than the band (the second half of the shutter), and the band vanished
+    // where it crossed the block: the rows of the band 0.14 RMS off their shutter average
+    // (contrast 0.95). Ordered by the depths of the two where they were both seen, 0.04.
+    const float band0 = 8.f, bandW = 24.f, bandY = 20.f;
+    auto blockAt = [](float fx, float fy, float t) { return fx >= 16.f && fx < 56.f && fy >= 8.f + 4.f * t && fy < 56.f + 4.f * t; };
+    auto bandAt = [&](float fx, float fy, float t) {
+        return fx >= band0 + 30.f * t && fx < band0 + bandW + 30.f * t && fy >= bandY && fy < bandY + 4.f;
+    };
+    auto value = [&](float fx, float fy, float t) { return bandAt(fx, fy, t) ? 0.05 : blockAt(fx, fy, t) ? 1.0 : 0.25; };
+    const LightFieldSamples lf = randomLightField(64, 64, 32, 5, [&](int x, int y, Vec2f film, float t) {
+        const float fx = float(x) + film.x, fy = float(y) + film.y;
+        if (bandAt(fx, fy, t))
+            return LightFieldSample::pack(film, {0.f, 0.f}, t, 4.35f, Vec2f{30.f, 0.f}, Vec3f(1.f), Vec3f(0.05f), 0);
+        if (blockAt(fx, fy, t)) {
+            const bool bottom = fy >= 32.f + 4.f * t;
+            return LightFieldSample::pack(film, {0.f, 0.f}, t, bottom ? 4.6f - t : 5.f, Vec2f{0.f, 4.f}, Vec3f(1.f), Vec3f(1.f), 0);
+        }
+        return LightFieldSample::pack(film, {0.f, 0.f}, t, 10.f, Vec2f{0.f, 0.f}, Vec3f(1.f), Vec3f(0.25f), 0);
+    });
+    const Image3f out = filter::reconstructLayers(filter::LayerInput{lf, pinholeView(64, 64), {}});
+    Image3f rows(64, 8);
+    for (int y = 0; y < 8; ++y)
+        for (int x = 0; x < 64; ++x) rows(x, y) = out(x, 18 + y);
+    const double rms = rmsFromShutterAverage(rows, [&](float fx, float fy, float t) { return value(fx, fy + 18.f, t); });
+    EXPECT_LT(rms, 0.08) << "the band's rows, RMS from their shutter average (contrast 0.95)";
+}
 
 TEST(Layers, TwelveObjectsMovingTwelveWaysInOneTileEachKeepTheirMotion) {
     // Twelve discs (radius 5 px, radiances 0.1 to 1) in one 64-px tile, each moving 12 or 20 px

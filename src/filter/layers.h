@@ -221,6 +221,13 @@ struct LayerStats {
 bool samplesSharpAndStill(const LightFieldSamples& samples, size_t p, const ViewGeometry& view, const LayerOptions& options = {},
                           int surface = -1);
 
+/// The front-to-back order of a tile's n layers in one order bin (reconstructLayers): from
+/// splitLayers' order 0 .. n - 1, with before[i * n + j] = 1 where layer i must go before layer j
+/// (set for pairs whose order changes over the shutter, either way). A layer goes just before the
+/// first layer it must precede, past layers it has no rule with, unless one it must follow comes
+/// later; the others keep splitLayers' order. `order` receives the n layers front to back.
+void orderLayers(const uint8_t* before, int n, int* order);
+
 /// The reflected radiance (no emission) of every pixel, reconstructed from the light field.
 /// `own`, where given, is set to 1 in the pixels whose rays all end in sharp still layers (every
 /// ray finds the same values there: the pixel's own samples, composited) and, among the pixels
