@@ -8,6 +8,7 @@ crop's relMSE against the reference's crop.
     python3 examples/layers_crops.py --out docs/layers-crops.png     # 2 minutes on 2 cores
     python3 examples/layers_crops.py --set camera --out docs/layers-camera-and-turns.png   # 8 minutes
     python3 examples/layers_crops.py --set order --out docs/layers-order.png   # 1 minute
+    python3 examples/layers_crops.py --set sliver --out docs/layers-sliver.png   # 2 minutes
 
 The crops are the rows of CROPS (scene, resolution, crop x, y, width, height); the
 reference is plain MC without layers with its own seed, so that its noise is independent of
@@ -50,7 +51,13 @@ ORDER_CROPS = [
     ("two moving layers: slats crossing the bunny's head", os.path.join(HERE, "..", "docs", "bunny-slats.json"), (256, 256),
      95, 80, 90, 60),
 ]
-CROP_SETS = {"default": CROPS, "camera": CAMERA_CROPS, "order": ORDER_CROPS}
+# --set sliver: the floor beside the bottom of a box coming towards the camera (docs/layers.md, "A
+# sliver of a moving box in front of the floor beside it").
+SLIVER_CROPS = [
+    ("a box coming closer: the floor at its bottom-left edge", os.path.join(HERE, "..", "docs", "moving-boxes.json"),
+     (384, 384), 205, 250, 60, 50),
+]
+CROP_SETS = {"default": CROPS, "camera": CAMERA_CROPS, "order": ORDER_CROPS, "sliver": SLIVER_CROPS}
 COLUMNS = [("mc", "off"), ("mc", "on"), ("aaf", "off"), ("aaf", "on")]
 
 
@@ -72,8 +79,8 @@ def main():
     p.add_argument("--out", default="layers-crops.png", help="output PNG (default layers-crops.png)")
     p.add_argument("--set", choices=sorted(CROP_SETS), default="default",
                    help="the crops: a defocused silhouette, the focal plane and moving objects (default), a "
-                        "moving camera, a turning camera and a turning object (camera), or two moving layers "
-                        "crossing (order)")
+                        "moving camera, a turning camera and a turning object (camera), two moving layers "
+                        "crossing (order), or the floor beside a box coming closer (sliver)")
     a = p.parse_args()
     if not 0 < a.scale <= 4:
         p.error("--scale: expected a number in (0, 4]")

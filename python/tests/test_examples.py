@@ -48,6 +48,13 @@ def test_layers_crops_of_two_moving_layers_crossing(tmp_path):
     check_png(out)
 
 
+def test_layers_crops_of_the_floor_beside_a_box_coming_closer(tmp_path):
+    out = tmp_path / "sliver.png"
+    run_example("layers_crops.py", "--set", "sliver", "--scale", "0.125", "--spp", "2", "--reference-spp", "4", "--zoom", "8",
+                "--out", out)
+    check_png(out)
+
+
 def test_layers_crops_of_a_moving_and_turning_camera(tmp_path):
     out = tmp_path / "camera.png"
     run_example("layers_crops.py", "--set", "camera", "--scale", "0.125", "--spp", "2", "--reference-spp", "4", "--zoom", "8",
