@@ -28,7 +28,9 @@
 //    thresholds widened until they fit). Layers are composited in the order of their mean
 //    inverse depth (a moving one's nearest sample's); two that cross in depth over the shutter,
 //    one of them moving, in the order of each of 8 bins of shutter time (layers.cpp,
-//    kOrderBins), and a sample counts in the D of the layers in front of its own at its time.
+//    kOrderBins; two moving layers by their depths in the cells where both were seen,
+//    kOrderVotes; orderLayers), and a sample counts in the D of the layers in front of its own at
+//    its time (not a sample nearer than all of a moving layer whose own layer lies wholly in front).
 // 2. Per layer, on a 1-pixel grid in its sharp image: N, the layer's samples at their own y; D,
 //    those and the samples of every layer behind it at the layer's shear y = x + c_l u - m_l (t -
 //    1/2) (c_l, m_l its means); W, R, G, B, its samples' radiance at their own y, in 8 bins of
