@@ -1812,7 +1812,9 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                     int nMoving = 0;
                     for (int k = 0; k < nLayers; ++k)
                         if (layers[size_t(k)].moving) movingSlot[size_t(k)] = nMoving++;
-                    nearCells.assign(size_t(nMoving) * kOrderBins * cells, -1.f);
+                    // (Only two moving layers are ordered by them.)
+                    const bool byCells = nMoving >= 2;
+                    if (byCells) nearCells.assign(size_t(nMoving) * kOrderBins * cells, -1.f);
                     // (A still layer's depth from every kOrderStride-th sample: a mean over cells
                     // of 8 x 8 pixels needs no more, and the still samples are most of a tile's.)
                     for (size_t i = 0; i < g.size(); ++i) {
@@ -1826,9 +1828,11 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                         const int k = split.layerOf(a), bin = timeBinOf(kOrderBins, a.t);
                         const size_t kb = size_t(k) * kOrderBins + size_t(bin);
                         binKey[kb] = std::max(binKey[kb], a.invDepth);
-                        const float g = layers[size_t(k)].depthRate, centre = (float(bin) + 0.5f) / float(kOrderBins);
-                        float& near = nearCells[(size_t(movingSlot[size_t(k)]) * kOrderBins + size_t(bin)) * cells + cellOf(a.x, a.y)];
-                        near = std::max(near, a.invDepth * (1.f + g * (a.t - 0.5f)) / (1.f + g * (centre - 0.5f)));
+                        if (byCells) {
+                            const float g = layers[size_t(k)].depthRate, centre = (float(bin) + 0.5f) / float(kOrderBins);
+                            float& near = nearCells[(size_t(movingSlot[size_t(k)]) * kOrderBins + size_t(bin)) * cells + cellOf(a.x, a.y)];
+                            near = std::max(near, a.invDepth * (1.f + g * (a.t - 0.5f)) / (1.f + g * (centre - 0.5f)));
+                        }
                         std::array<float, 4>& bx = box[kb];
                         bx[0] = std::min(bx[0], a.x), bx[1] = std::min(bx[1], a.y), bx[2] = std::max(bx[2], a.x), bx[3] = std::max(bx[3], a.y);
                     }
@@ -1870,7 +1874,6 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                     //   Layers.AMovingLayerGoesBeforeAStillOneItReachesInFrontOf).
                     std::vector<uint8_t>& before = local.before;  // [(b * n + i) * n + j]
                     before.assign(size_t(kOrderBins) * nLayers * nLayers, 0);
-                    reordered.assign(size_t(nLayers), 0);
                     bool any = false;
                     for (int i = 0; i < nLayers; ++i)
                         for (int j = i + 1; j < nLayers; ++j) {
@@ -1879,7 +1882,7 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                             auto key = [&](int k, int b) { return binKey[size_t(k) * kOrderBins + size_t(b)]; };
                             auto set = [&](int b, bool jFirst) {
                                 before[(size_t(b) * nLayers + size_t(jFirst ? j : i)) * nLayers + size_t(jFirst ? i : j)] = 1;
-                                if (jFirst) any = true, reordered[size_t(i)] = reordered[size_t(j)] = 1;  // (i is before j in splitLayers' order)
+                                any |= jFirst;  // (i is before j in splitLayers' order)
                             };
                             if (li.moving && lj.moving) {
                                 int say[kOrderBins] = {};  // 1: i first, -1: j first, 0: no say
@@ -1936,7 +1939,7 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                         // A layer is reordered where its order against another one is not
                         // splitLayers' in some bin: also a layer that another one jumped
                         // (orderLayers), though no rule of its own changed.
-                        std::fill(reordered.begin(), reordered.end(), uint8_t(0));
+                        reordered.assign(size_t(nLayers), 0);
                         for (int b = 0; b < kOrderBins; ++b) {
                             const int* rank = &binRank[size_t(b) * nLayers];
                             for (int i = 0; i < nLayers; ++i)
@@ -2565,13 +2568,19 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                         // pan through Sponza (docs/sponza-pan.json) 74% of the pixels straddle,
                         // and the tolerance takes AAF from 99 to 67 rays a pixel (docs/layers.md,
                         // "Extra rays only where the first ones disagree").
+                        // Ray j's light: light the layers leave uncovered (a hole no sample saw) is
+                        // taken as the mean of what they cover.
+                        auto rayLight = [&](int j) {
+                            const Vec3f c(ray.cr[j], ray.cg[j], ray.cb[j]);
+                            const float t = ray.trans[j];
+                            return t > 1e-4f && t < 1.f ? c / (1.f - t) : c;
+                        };
                         if (pixelRays == rays && mixedRays > rays) {
                             if (straddles && o.rayTolerance > 0.f) {
                                 double sum = 0, sum2 = 0;
                                 for (int j = 0; j < rays; ++j) {
-                                    const float t = ray.trans[j];
-                                    const float scale = t > 1e-4f && t < 1.f ? 1.f / (3.f * (1.f - t)) : 1.f / 3.f;  // (as the pixel's sum below)
-                                    const double v = double((ray.cr[j] + ray.cg[j] + ray.cb[j]) * scale);
+                                    const Vec3f l = rayLight(j);
+                                    const double v = double(l.x + l.y + l.z) / 3.0;
                                     sum += v, sum2 += v * v;
                                 }
                                 const double mean = sum / rays, variance = std::max(0.0, sum2 / rays - mean * mean);
@@ -2583,14 +2592,8 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                                 ++straddling;
                             }
                         }
-                        // Light the layers leave uncovered (a hole no sample saw) is taken as
-                        // the mean of what they cover.
                         Vec3f sum(0.f);
-                        for (int j = 0; j < pixelRays; ++j) {
-                            const Vec3f c(ray.cr[j], ray.cg[j], ray.cb[j]);
-                            const float t = ray.trans[j];
-                            sum += t > 1e-4f && t < 1.f ? c / (1.f - t) : c;
-                        }
+                        for (int j = 0; j < pixelRays; ++j) sum += rayLight(j);
                         out(x, y) = sum / float(pixelRays);
                         multiRay += pixelRays > 1;
                         raysTraced += uint64_t(pixelRays);
