@@ -106,7 +106,7 @@ public:
         if (auto r = root.optional("render")) parseRender(*r);
         root.finish();
         if (m_desc.lights.empty())
-            throw Error(m_file + ": lights", "the scene has no light (add a parallelogram or triangle light, or an emissive surface)");
+            throw Error(m_file + ": lights", "the scene has no light (add a parallelogram, triangle or sphere light, or an emissive surface)");
         if (m_desc.meshes.empty() && m_desc.spheres.empty()) throw Error(m_file + ": objects", "the scene has no geometry");
         return std::move(m_desc);
     }
