@@ -588,7 +588,9 @@ TEST(Layers, APanGathersAlongItsMotionOnlyAndATileForItsPixelsThatTraceRays) {
     for (int y = 0; y < H; ++y)
         for (int x = 0; x < W; ++x) {
             ASSERT_EQ(own(x, y), left(x, y)) << x << ", " << y;
-            if (!left(x, y)) ASSERT_NEAR(block(x, y).x, 0.5f, 1e-3f) << x << ", " << y;
+            if (!left(x, y)) {
+                ASSERT_NEAR(block(x, y).x, 0.5f, 1e-3f) << x << ", " << y;
+            }
         }
 }
 

@@ -134,6 +134,23 @@ TEST(Mpi, AafAroundATurningBarIsBitIdenticalToOneProcess) {
     expectSameAsOneProcess("render " + dir + "/turn.json --method aaf --spp 4 --quiet");
 }
 
+TEST(Mpi, McAroundASpinningBarIsBitIdenticalToOneProcess) {
+    REQUIRE_MPI();
+    // A bar spinning 90 degrees in the image plane before a wall: its samples keep their paths'
+    // sagittas beside them (LightFieldSag), which the ranks exchange with the samples.
+    const std::string dir = tempDir();
+    writeFile(dir + "/spin.json", R"({
+      "camera": {"position": [0, 0, 0], "look_at": [0, 0, -1], "up": [0, 1, 0], "fov_y": 20, "resolution": [64, 48]},
+      "materials": {"white": {"albedo": [0.8, 0.8, 0.8]}},
+      "lights": [{"type": "parallelogram", "corner": [-1, 2, -3], "edge1": [0, 0, -2], "edge2": [2, 0, 0], "radiance": [5, 5, 5]}],
+      "objects": [{"type": "quad", "corner": [-0.45, -0.04, -4], "edge1": [0.9, 0, 0], "edge2": [0, 0.08, 0], "material": "white",
+                   "angular_velocity": [0, 0, 1, 90]},
+                  {"type": "quad", "corner": [-3, -3, -6], "edge1": [6, 0, 0], "edge2": [0, 6, 0], "material": "white"}],
+      "render": {"spp": 4, "seed": 5, "indirect": true}
+    })");
+    expectSameAsOneProcess("render " + dir + "/spin.json --method mc --spp 4 --quiet");
+}
+
 TEST(Mpi, AtrousIsBitIdenticalToOneProcess) {
     REQUIRE_MPI();
     expectSameAsOneProcess("render cornell --method atrous --spp 4 --resolution 64x47 --quiet");

@@ -5,7 +5,8 @@
 // samples along their defocus and motion trajectories across pixels (Lehtinen et al. 2011,
 // Munkberg et al. 2014).
 //
-// 24 bytes a sample: at 720x720 and 31 spp on average (AAF on conference) 386 MB. Colours are
+// 24 bytes a sample (4 more where an object turns: the sagitta of its path, beside it): at
+// 720x720 and 31 spp on average (AAF on conference) 386 MB. Colours are
 // shared-exponent RGB9E5 (9-bit mantissas, one 5-bit exponent: 1/512 of the largest channel),
 // lens and film positions fixed point. Samples are kept per pixel in the order they were taken,
 // in stages (initial, adaptive), so that every pixel's samples and their order depend only on
@@ -97,6 +98,16 @@ struct LightFieldSample {
     bool hit() const { return depth < kInf; }
 };
 static_assert(sizeof(LightFieldSample) == 24);
+/// Where a turning object's point is at mid-shutter on the screen, off its path's chord's middle
+/// (TracedSample::sag), 1/8 pixel: kept beside the samples where an object of the scene turns.
+struct LightFieldSag {
+    int16_t x = 0, y = 0;
+    static LightFieldSag pack(Vec2f sag) {
+        auto q = [](float v) { return int16_t(std::lround(std::clamp(v, -LightFieldSample::kMaxMotion, LightFieldSample::kMaxMotion) * 8.f)); };
+        return {q(sag.x), q(sag.y)};
+    }
+    Vec2f unpack() const { return {float(x) / 8.f, float(y) / 8.f}; }
+};
 static_assert(std::is_trivially_copyable_v<LightFieldSample> && std::is_trivially_destructible_v<LightFieldSample>,
               "LightFieldSamples leaves its samples unwritten until they are recorded (UnwrittenAllocator)");
 
@@ -105,7 +116,10 @@ static_assert(std::is_trivially_copyable_v<LightFieldSample> && std::is_triviall
 class LightFieldSamples {
 public:
     LightFieldSamples() = default;
-    LightFieldSamples(int width, int height) : m_width(width), m_height(height), m_bentReach(size_t(width) * height, 0.f) {}
+    /// `curved`: keep each sample's sagitta beside it (LightFieldSag; where an object turns).
+    LightFieldSamples(int width, int height, bool curved = false)
+        : m_width(width), m_height(height), m_curved(curved), m_bentReach(size_t(width) * height, 0.f) {}
+    bool curved() const { return m_curved; }
 
     int width() const { return m_width; }
     int height() const { return m_height; }
@@ -122,14 +136,18 @@ public:
         s.offset.resize(pixels + 1);
         s.offset[0] = 0;
         for (size_t p = 0; p < pixels; ++p) s.offset[p + 1] = s.offset[p] + count(p);
-        checkMemory("--layers", "keeping every sample (" + std::to_string(s.offset[pixels] + samples()) + " at 24 bytes)",
-                    uint64_t(bytes() + s.offset[pixels] * sizeof(LightFieldSample)));
+        checkMemory("--layers",
+                    "keeping every sample (" + std::to_string(s.offset[pixels] + samples()) + " at " + std::to_string(sampleBytes()) + " bytes)",
+                    uint64_t(bytes() + s.offset[pixels] * sampleBytes()));
         s.samples = Samples(s.offset[pixels]);  // unwritten: every slot is written once, by its pixel's thread
+        if (m_curved) s.sags = Sags(s.offset[pixels]);
         m_stages.push_back(std::move(s));
         return int(m_stages.size()) - 1;
     }
     /// The run of pixel p in stage `stage` (sample k of the stage at [k]).
     LightFieldSample* run(int stage, size_t p) { return m_stages[stage].samples.data() + m_stages[stage].offset[p]; }
+    /// ... and their sagittas (curved() only).
+    LightFieldSag* sagRun(int stage, size_t p) { return m_stages[stage].sags.data() + m_stages[stage].offset[p]; }
     uint32_t runLength(int stage, size_t p) const {
         return uint32_t(m_stages[stage].offset[p + 1] - m_stages[stage].offset[p]);
     }
@@ -139,6 +157,13 @@ public:
     void forEach(size_t p, Fn&& fn) const {
         for (const Stage& s : m_stages)
             for (uint64_t i = s.offset[p]; i < s.offset[p + 1]; ++i) fn(s.samples[i]);
+    }
+    /// fn(const LightFieldSample&, Vec2f sag) likewise, with each sample's sagitta (0 where the
+    /// samples keep none).
+    template <class Fn>
+    void forEachWithSag(size_t p, Fn&& fn) const {
+        for (const Stage& s : m_stages)
+            for (uint64_t i = s.offset[p]; i < s.offset[p + 1]; ++i) fn(s.samples[i], m_curved ? s.sags[i].unpack() : Vec2f{0.f, 0.f});
     }
     template <class Fn>
     void forEachMutable(size_t p, Fn&& fn) {
@@ -158,7 +183,8 @@ public:
     /// Per pixel, how far (pixels, a square) from it its samples reach once reprojected, of those
     /// whose paths bend more than kBentPath on a surface that turns towards or away from the
     /// camera by more than kFaceTurn (0: none); marked as they are recorded
-    /// (LightFieldStage::record). The layered reconstruction follows each sample's chord and
+    /// (LightFieldStage::record). The layered reconstruction follows each sample's chord (its arc only
+    /// for turns in depth up to kCurvedTurnInDepth) and
     /// holds one sharp image per layer at mid-shutter, which cannot show the parts of an object
     /// that turn into or out of view over the shutter: aaf and maaf keep their own composition
     /// within that reach (render/renderer.cpp; docs/layers.md, "Arcs").
@@ -178,20 +204,25 @@ public:
 
     size_t bytes() const {
         size_t b = 0;  // (the samples; bentReach's 4 bytes a pixel beside them are not counted)
-        for (const Stage& s : m_stages) b += s.samples.size() * sizeof(LightFieldSample) + s.offset.size() * sizeof(uint64_t);
+        for (const Stage& s : m_stages) b += s.samples.size() * sampleBytes() + s.offset.size() * sizeof(uint64_t);
         return b;
     }
+    /// A sample's bytes, its sagitta's included where they are kept.
+    size_t sampleBytes() const { return sizeof(LightFieldSample) + (m_curved ? sizeof(LightFieldSag) : 0); }
 
 private:
     // Left unwritten when allocated (UnwrittenAllocator): each sample is written once as it is
     // recorded (or copied from its rank), so the pages are first touched by the sampling
     // threads, not zeroed by one thread before (Sponza 512x512, 16 spp: 100 MB).
     using Samples = std::vector<LightFieldSample, UnwrittenAllocator<LightFieldSample>>;
+    using Sags = std::vector<LightFieldSag, UnwrittenAllocator<LightFieldSag>>;
     struct Stage {
         std::vector<uint64_t> offset;  // pixels + 1
         Samples samples;
+        Sags sags;  // (curved() only) beside samples
     };
     int m_width = 0, m_height = 0;
+    bool m_curved = false;
     std::vector<Stage> m_stages;
     std::vector<float> m_bentReach;
 };

@@ -30,8 +30,9 @@ struct Gathered {
     int8_t surface;
     uint8_t cls;  // 0: still; 1 + g: moving, in the tile's motion group g (kMotionGroups)
     uint16_t bin;  // its slope bin in its class's histogram (splitLayers)
+    float sx, sy;  // the sagitta of a turning object's path (LightFieldSample::sag; 0 elsewhere)
 };
-static_assert(sizeof(Gathered) == 52, "the bin fits in what was padding");
+static_assert(sizeof(Gathered) == 60, "the bin fits in what was padding");
 
 /// A layer whose slopes spread less than this (pixels per unit lens coordinate) is sheared with
 /// its mean slope alone; a wider one's rays take the slope of the surface they find.
@@ -214,6 +215,24 @@ inline Vec2f shearOf(const Gathered& s, float c, float mx, float my, float g) {
 inline Vec2f layerPosition(const Gathered& s, bool sharp, float c, float mx, float my, float g) {
     return sharp ? Vec2f{s.x, s.y} : shearOf(s, c, mx, my, g);
 }
+/// Curved trajectories. A turning object's point moves on the screen along an arc, not its
+/// chord: at mid-shutter it is off the chord's middle by its sagitta s (TracedSample::sag;
+/// along the chord as well as across it: a point turning in depth near a silhouette moves
+/// unevenly along it). Its sample is reprojected along the parabola through the chord's ends and
+/// that point, y(t) = chord(t) - 4 e (t - 1/2)^2, chord(t) the chord at alongChord's pace,
+/// whose mid-shutter point is already m g / 4 along the chord (alongChord), so e = s - m g / 4.
+/// Along the chord alone a sample taken at the open or the close of the shutter landed up to
+/// |s| from its point's mid-shutter place, and a turning bunny's silhouette, whose points move
+/// in depth there, came out sharp and 2 px wide of its blurred edge (docs/layers.md, "Curved
+/// trajectories"). Where a sample lies in its own layer's sharp image: its shear plus this.
+inline Vec2f curvedShift(const Gathered& s, float g) {
+    const float d = s.t - 0.5f, k = 4.f * d * d;
+    return {k * (s.sx - 0.25f * g * s.mx), k * (s.sy - 0.25f * g * s.my)};
+}
+/// The effective sagitta e of a sample in a layer of depth rate g (curvedShift).
+inline Vec2f effectiveSag(const Gathered& s, float g) { return {s.sx - 0.25f * g * s.mx, s.sy - 0.25f * g * s.my}; }
+inline bool curved(const Gathered& s) { return s.sx != 0.f || s.sy != 0.f; }
+
 /// The time bin of shutter time t among `bins`.
 inline int timeBinOf(int bins, float t) { return std::min(bins - 1, int(t * float(bins))); }
 
@@ -293,6 +312,12 @@ struct Layer {
     float motionScale = 1, maxMotion = 0;
     float motionSpread = 0;  // the largest |motion - motionFit.mean| over motionGrid
     std::vector<float> motionGrid;
+    // Where its samples are a turning object's: per cell (as motionGrid) the mean effective
+    // sagitta of their paths (curvedShift), 0 where it has none; empty where no sample of the
+    // layer turns. maxSag: its largest length.
+    std::vector<float> sagGrid;
+    float maxSag = 0;
+    AffineMotion sagFit;  // the affine fit of the effective sagittas to the sharp position, as motionFit
     // The affine fit of its samples' motion to their sharp position, its centre in film pixels:
     // where a ray or a sample behind starts on the layer (motionShift).
     AffineMotion motionFit;
@@ -1195,17 +1220,20 @@ AffineMotion fitMotion(const std::vector<float>& acc, int gw, int gh, Vec2f fall
     return fit;
 }
 
-/// A moving layer's mean motion (motionGrid) at a bilinear lookup.
-[[gnu::always_inline]] inline Vec2f motionAt(const Layer& l, const Bilinear& b) {
-    const float* motion = l.motionGrid.data();
-    float mx = 0, my = 0;
+/// A grid of 2-vectors (a layer's motionGrid or sagGrid, x and y per cell) at a bilinear lookup.
+[[gnu::always_inline]] inline Vec2f vectorAt(const float* grid, const Bilinear& b) {
+    float vx = 0, vy = 0;
 #pragma GCC unroll 4
     for (int k = 0; k < 4; ++k) {
-        mx += b.w[k] * motion[2 * b.cell[k]];
-        my += b.w[k] * motion[2 * b.cell[k] + 1];
+        vx += b.w[k] * grid[2 * b.cell[k]];
+        vy += b.w[k] * grid[2 * b.cell[k] + 1];
     }
-    return {mx, my};
+    return {vx, vy};
 }
+/// A moving layer's mean motion (motionGrid) at a bilinear lookup.
+[[gnu::always_inline]] inline Vec2f motionAt(const Layer& l, const Bilinear& b) { return vectorAt(l.motionGrid.data(), b); }
+/// A turning layer's mean effective sagitta (sagGrid) at a bilinear lookup.
+[[gnu::always_inline]] inline Vec2f sagAt(const Layer& l, const Bilinear& b) { return vectorAt(l.sagGrid.data(), b); }
 /// Shutter time t between the centres of a layer's `bins` time bins: bins b0 and b1 (the same
 /// for a still layer, one bin, or in the last bin's half) and the weight `at` of b1.
 struct TimeLerp {
@@ -1274,6 +1302,20 @@ struct Rays {
     return {solvable ? qx - (a11 * rx - a01 * ry) / det : fallback.x, solvable ? qy - (a00 * ry - a10 * rx) / det : fallback.y};
 }
 
+/// motionShift on a turning layer's arcs (Layer::sagGrid): the point p of the sharp image with
+/// q = p + s m(p) - k e(p), e the affine fit of the effective sagittas (Layer::sagFit) and k =
+/// 4 tau^2 (curvedShift), solved as (I + s B - k E) p = q - s (m0 - B c) + k (e0 - E c_e);
+/// returns s m(p) - k e(p).
+[[gnu::always_inline]] inline Vec2f curvedMotionShift(const AffineMotion& f, const AffineMotion& e, float qx, float qy, float s, float k,
+                                                      Vec2f fallback) {
+    const float a00 = 1.f + s * f.b00 - k * e.b00, a01 = s * f.b01 - k * e.b01, a10 = s * f.b10 - k * e.b10, a11 = 1.f + s * f.b11 - k * e.b11;
+    const float rx = qx - s * (f.mean.x - (f.b00 * f.centre.x + f.b01 * f.centre.y)) + k * (e.mean.x - (e.b00 * e.centre.x + e.b01 * e.centre.y));
+    const float ry = qy - s * (f.mean.y - (f.b10 * f.centre.x + f.b11 * f.centre.y)) + k * (e.mean.y - (e.b10 * e.centre.x + e.b11 * e.centre.y));
+    const float det = a00 * a11 - a01 * a10;
+    const bool solvable = det > 0.2f;
+    return {solvable ? qx - (a11 * rx - a01 * ry) / det : fallback.x, solvable ? qy - (a00 * ry - a10 * rx) / det : fallback.y};
+}
+
 /// Rays [j0, j1) through a blurred layer (the `index`-th a pixel's rays see): the layer's lens
 /// and shutter shear, then (kFollow) the slope of the surface found there, shaped by the grid's
 /// blur, and the layer's alpha and premultiplied light there (kMoving: between its two nearest
@@ -1282,21 +1324,29 @@ struct Rays {
 /// same order, as one SIMD loop (its images the same to float rounding, docs/layers.md): every
 /// lane is computed, and a stopped ray's results are not stored. Returns whether a ray took
 /// part of the layer's coverage.
-template <bool kFollow, bool kMoving>
+template <bool kFollow, bool kMoving, bool kCurved = false>
 bool traceBlurred(const Layer& l, int index, Rays& ray, int j0, int j1) {
     const int cs = l.cellStride(), bins = l.timeBins;
     const float* cell = l.cell.data();
     const bool followMotion = kMoving && !l.motionGrid.empty();
-    const AffineMotion fit = l.motionFit;
+    const AffineMotion fit = l.motionFit, sagFit = l.sagFit;
     int partial = 0;
 #pragma omp simd reduction(| : partial)
     for (int j = j0; j < j1; ++j) {
         const float dt = ray.dt[j];
-        const float st = alongChord(dt * (1.f + l.rayT2 * 4.f * dt * dt), l.depthRate);
+        const float shaped = dt * (1.f + l.rayT2 * 4.f * dt * dt);
+        const float st = alongChord(shaped, l.depthRate);
         float mox = l.rayMx * st, moy = l.rayMy * st;
         float cRay = l.rayC + l.rayC2 * ray.u2[j];
         if (followMotion) {
-            const Vec2f shift = motionShift(fit, ray.px[j] + cRay * ray.ux[j], ray.py[j] - cRay * ray.uy[j], l.motionScale * st, {mox, moy});
+            Vec2f shift;
+            if constexpr (kCurved) {
+                const float tau = l.motionScale * shaped;
+                shift = curvedMotionShift(fit, sagFit, ray.px[j] + cRay * ray.ux[j], ray.py[j] - cRay * ray.uy[j], l.motionScale * st,
+                                          4.f * tau * tau, {mox, moy});
+            } else {
+                shift = motionShift(fit, ray.px[j] + cRay * ray.ux[j], ray.py[j] - cRay * ray.uy[j], l.motionScale * st, {mox, moy});
+            }
             mox = shift.x, moy = shift.y;
         }
         if (kFollow || followMotion) {
@@ -1315,6 +1365,20 @@ bool traceBlurred(const Layer& l, int index, Rays& ray, int j0, int j1) {
                     const Vec2f m = motionAt(l, b);
                     mox = l.motionScale * m.x * st;
                     moy = l.motionScale * m.y * st;
+                    if constexpr (kCurved) {
+                        // On its arc (curvedShift): the point it finds there is 4 e tau^2 back
+                        // towards its mid-shutter place, tau the ray's shutter offset as its
+                        // motion is scaled; then a second step, the motion and the sagitta where
+                        // the first put it (the sagitta moves the lookup by up to its length).
+                        const float tau = l.motionScale * shaped, k = 4.f * tau * tau;
+                        const Vec2f e = sagAt(l, b);
+                        mox -= k * e.x;
+                        moy -= k * e.y;
+                        const Bilinear b2 = bilinear(l, {ray.px[j] + cRay * ray.ux[j] - mox, ray.py[j] - cRay * ray.uy[j] - moy});
+                        const Vec2f m2 = motionAt(l, b2), e2 = sagAt(l, b2);
+                        mox = l.motionScale * m2.x * st - k * e2.x;
+                        moy = l.motionScale * m2.y * st - k * e2.y;
+                    }
                 }
             }
         }
@@ -1362,23 +1426,36 @@ struct MotionBatch {
 /// layer's coverage reads (reconstructLayers). p lies within |dt| maxMotion of q (|m| <=
 /// maxMotion, a bilinear mean of the grid's motions), so that test needs no solve; a cell to
 /// spare for rounding.
+/// (kCurved: the layer's points on their arcs, Layer::sagGrid, as a ray's.)
+template <bool kCurved>
 void motionCells(const Layer& l, const int* occupied, int margin, MotionBatch& b) {
     const int gw = l.gw, gh = l.gh, ow = gw + 1, n = b.n;
-    const AffineMotion fit = l.motionFit;
+    const AffineMotion fit = l.motionFit, sagFit = l.sagFit;
 #pragma omp simd
     for (int j = 0; j < n; ++j) {
         const float qx = b.qx[j], qy = b.qy[j], dt = alongChord(b.t[j] - 0.5f, l.depthRate);
-        const float r = std::abs(dt) * l.maxMotion + 1.f;
+        const float r = std::abs(dt) * l.maxMotion + (kCurved ? l.maxSag : 0.f) + 1.f;
+        const float d = b.t[j] - 0.5f, k = 4.f * d * d;  // (kCurved)
         const int i0 = int(std::floor(qx - r)) - l.gx0 - margin, i1 = int(std::floor(qx + r)) - l.gx0 + margin;
         const int j0 = int(std::floor(qy - r)) - l.gy0 - margin, j1 = int(std::floor(qy + r)) - l.gy0 + margin;
         // The rectangle clamped to the grid (empty where it misses the grid).
         const int a0 = minValue(gw, maxValue(0, i0)), a1 = minValue(gw, maxValue(0, i1 + 1));
         const int c0 = minValue(gh, maxValue(0, j0)), c1 = minValue(gh, maxValue(0, j1 + 1));
         const int samples = occupied[c1 * ow + a1] - occupied[c1 * ow + a0] - occupied[c0 * ow + a1] + occupied[c0 * ow + a0];
-        const Vec2f shift = motionShift(fit, qx, qy, dt, Vec2f{l.mx * dt, l.my * dt});
-        const Vec2f m = motionAt(l, bilinear(l, {qx - shift.x, qy - shift.y}));
+        const Vec2f shift = kCurved ? curvedMotionShift(fit, sagFit, qx, qy, dt, k, Vec2f{l.mx * dt, l.my * dt})
+                                    : motionShift(fit, qx, qy, dt, Vec2f{l.mx * dt, l.my * dt});
+        const Bilinear at = bilinear(l, {qx - shift.x, qy - shift.y});
+        const Vec2f m = motionAt(l, at);
+        float px = qx - m.x * dt, py = qy - m.y * dt;
+        if constexpr (kCurved) {  // (and a second step, as a ray's: traceBlurred)
+            const Vec2f e = sagAt(l, at);
+            const Bilinear at2 = bilinear(l, {px + k * e.x, py + k * e.y});
+            const Vec2f m2 = motionAt(l, at2), e2 = sagAt(l, at2);
+            px = qx - m2.x * dt + k * e2.x;
+            py = qy - m2.y * dt + k * e2.y;
+        }
         // (gridCell's cell, with its tests as one mask for the SIMD loop.)
-        const int ci = int(std::floor(qx - m.x * dt)) - l.gx0, cj = int(std::floor(qy - m.y * dt)) - l.gy0;
+        const int ci = int(std::floor(px)) - l.gx0, cj = int(std::floor(py)) - l.gy0;
         const int counts = int(unsigned(ci) < unsigned(gw)) & int(unsigned(cj) < unsigned(gh)) & int(samples > 0);
         b.cell[j] = counts ? cj * gw + ci : -1;
     }
@@ -1451,11 +1528,11 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
         for (int x = 0; x < W; ++x) {
             const size_t p = size_t(y) * W + x;
             Vec2f r{};
-            lf.forEach(p, [&](const LightFieldSample& s) {
+            lf.forEachWithSag(p, [&](const LightFieldSample& s, Vec2f sag) {  // (on its arc a sample lands up to |sag| off its chord: curvedShift)
                 if (s.surface() != 0) mixed[p] = 1;
                 const Vec2f m = s.motion();
                 const float c = 2.f * std::abs(view.defocusSlope(s.hit() ? s.depth : kInf));
-                r = vmax(r, Vec2f{c + std::abs(m.x), c + std::abs(m.y)});
+                r = vmax(r, Vec2f{c + std::abs(m.x) + std::abs(sag.x), c + std::abs(m.y) + std::abs(sag.y)});
             });
             reach[p] = vmin(r, Vec2f{float(o.maxReach), float(o.maxReach)});
         }
@@ -1558,6 +1635,7 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
         // The D pass of the layers with a motion grid (withGrid): per layer, its cells with
         // samples summed over rectangles, its margin, and the samples behind it, a batch at a time.
         std::vector<int> withGrid, margin;
+        std::vector<float> sagFitIn;  // a turning layer's counts and sagitta sums, for its fit
         std::vector<std::array<float, 4>> reachBox, ownBox;
         std::vector<std::vector<int>> occupied;
         std::vector<MotionBatch> batch;
@@ -1616,7 +1694,7 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                     for (int x = rx0; x < rx1; ++x) {
                         const size_t q = size_t(y) * W + x;
                         pixelStart[size_t(y - ry0) * rw + (x - rx0)] = uint32_t(next - g.data());
-                        lf.forEach(q, [&](const LightFieldSample& s) {
+                        lf.forEachWithSag(q, [&](const LightFieldSample& s, Vec2f sag) {
                             Gathered a;
                             const Vec2f f = s.film(), l = s.lens(), m = s.motion();
                             a.x = float(x) + f.x;
@@ -1626,6 +1704,8 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                             a.t = s.time();
                             a.mx = m.x;
                             a.my = m.y;
+                            a.sx = sag.x;
+                            a.sy = sag.y;
                             a.cls = uint8_t(movesOnScreen(m) ? 1 : 0);
                             anyMoving |= a.cls != 0;
                             // slopeOf and the inverse depth from one division (the same values).
@@ -2011,6 +2091,7 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                 // Splat: N and D at the layer's shear, W and the radiance at the sample's own.
                 bool anyMotionGrid = false;
                 std::vector<std::vector<float>> motionAcc(layers.size());
+                std::vector<std::vector<float>> sagAcc(layers.size());  // per cell: the sums of the effective sagittas (Layer::sagGrid)
                 for (size_t k = 0; k < layers.size(); ++k)
                     if (layers[k].moving && !layers[k].sharp && layers[k].motionScale > 0.f) {
                         motionAcc[k].assign(size_t(layers[k].gw) * layers[k].gh * 3, 0.f);
@@ -2092,9 +2173,23 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                     sampleLayer[i] = uint16_t(sl);
                     // Its own layer's N, D, W and radiance at its own trajectory's point.
                     const SplatTarget& l = target[size_t(sl)];
-                    const Vec2f own = layerPosition(s, l.sharp, s.c, s.mx, s.my, l.depthRate);
+                    Vec2f own = layerPosition(s, l.sharp, s.c, s.mx, s.my, l.depthRate);
+                    // (A turning object's sample on its arc: only in a layer with a motion grid,
+                    // whose rays and D follow the grid's sagittas.)
+                    const bool arc = l.motion && curved(s);
+                    if (arc) {
+                        const Vec2f shift = curvedShift(s, l.depthRate);
+                        own = {own.x + shift.x, own.y + shift.y};
+                    }
                     const int ci = l.cellIndex(own);
                     if (ci < 0) continue;
+                    if (arc) {
+                        std::vector<float>& sa = sagAcc[size_t(sl)];
+                        if (sa.empty()) sa.assign(size_t(l.gw) * l.gh * 2, 0.f);
+                        const Vec2f e = effectiveSag(s, l.depthRate);
+                        sa[size_t(ci) * 2] += e.x;
+                        sa[size_t(ci) * 2 + 1] += e.y;
+                    }
                     float* cellAcc = l.acc + size_t(ci) * l.accStride;
                     cellAcc[0] += 1.f;
                     l.d[ci] += 1.f;
@@ -2200,6 +2295,17 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                         const AffineMotion fit = fitMotion(motionAcc[k], l.gw, l.gh, Vec2f{l.mx, l.my});
                         l.motionFit = fit;
                         l.motionFit.centre = {fit.centre.x + float(l.gx0), fit.centre.y + float(l.gy0)};
+                        // (A turning layer's sagittas fitted likewise, before the sums are smoothed.)
+                        AffineMotion sagFit;
+                        if (!sagAcc[k].empty()) {
+                            std::vector<float>& fitIn = local.sagFitIn;
+                            fitIn.resize(size_t(l.gw) * l.gh * 3);
+                            for (size_t i = 0; i < size_t(l.gw) * l.gh; ++i)
+                                fitIn[i * 3] = motionAcc[k][i * 3], fitIn[i * 3 + 1] = sagAcc[k][i * 2], fitIn[i * 3 + 2] = sagAcc[k][i * 2 + 1];
+                            sagFit = fitMotion(fitIn, l.gw, l.gh, Vec2f{0.f, 0.f});
+                            l.sagFit = sagFit;
+                            l.sagFit.centre = {sagFit.centre.x + float(l.gx0), sagFit.centre.y + float(l.gy0)};
+                        }
                         smooth(motionAcc[k], l.gw, l.gh, 3, l.sigmaX(l.sigma), l.sigmaY(l.sigma));
                         l.motionGrid.resize(size_t(l.gw) * l.gh * 2);
                         const size_t cells = size_t(l.gw) * l.gh;
@@ -2227,6 +2333,36 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                         }
                         l.maxMotion = std::sqrt(reach);
                         l.motionSpread = std::sqrt(spread);
+                        // The mean effective sagitta per cell: the sums smoothed as the motion's,
+                        // over the same (smoothed) count.
+                        l.sagGrid.clear();
+                        l.maxSag = 0;
+                        if (!sagAcc[k].empty()) {
+                            smooth(sagAcc[k], l.gw, l.gh, 2, l.sigmaX(l.sigma), l.sigmaY(l.sigma));
+                            l.sagGrid.resize(cells * 2);
+                            float sagDeviation = 0;  // (as the motion's: the fit within the spread seen)
+                            for (size_t i = 0; i < cells; ++i) {
+                                const float n = motionAcc[k][i * 3];
+                                if (n >= 0.05f)
+                                    sagDeviation = std::max(sagDeviation, sqr(sagAcc[k][i * 2] / n - sagFit.mean.x) + sqr(sagAcc[k][i * 2 + 1] / n - sagFit.mean.y));
+                            }
+                            sagDeviation = std::sqrt(sagDeviation);
+                            float most = 0;
+                            for (size_t i = 0; i < cells; ++i) {
+                                const float n = motionAcc[k][i * 3];
+                                Vec2f e;
+                                if (n >= 0.05f) {
+                                    e = {sagAcc[k][i * 2] / n, sagAcc[k][i * 2 + 1] / n};
+                                } else {
+                                    const Vec2f p{float(i % size_t(l.gw)) + 0.5f, float(i / size_t(l.gw)) + 0.5f};
+                                    e = sagFit.at(p, sagDeviation);
+                                }
+                                l.sagGrid[2 * i] = e.x;
+                                l.sagGrid[2 * i + 1] = e.y;
+                                most = std::max(most, e.x * e.x + e.y * e.y);
+                            }
+                            l.maxSag = std::sqrt(most);
+                        }
                     }
                     // Each sample's point on the layers in front of it goes into that layer's
                     // batch, and a full batch's cells are found by one SIMD loop (motionCells):
@@ -2270,7 +2406,7 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                         const int m = dMargin(l);
                         margin[size_t(k)] = m;
                         // (motionCells' r is at most |dt| maxMotion + 1, |dt| at most chordReach; a cell to spare.)
-                        const float reach = float(m) + chordReach(l.depthRate) * l.maxMotion + 2.f;
+                        const float reach = float(m) + chordReach(l.depthRate) * l.maxMotion + l.maxSag + 2.f;
                         if (bx1 >= 0) {
                             reachBox[size_t(k)] = {float(l.gx0 + bx0) - reach, float(l.gy0 + by0) - reach, float(l.gx0 + bx1 + 1) + reach,
                                                    float(l.gy0 + by1 + 1) + reach};
@@ -2280,7 +2416,10 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                     }
                     auto flush = [&](int k) {
                         MotionBatch& b = batch[size_t(k)];
-                        motionCells(layers[size_t(k)], occupied[size_t(k)].data(), margin[size_t(k)], b);
+                        if (layers[size_t(k)].sagGrid.empty())
+                            motionCells<false>(layers[size_t(k)], occupied[size_t(k)].data(), margin[size_t(k)], b);
+                        else
+                            motionCells<true>(layers[size_t(k)], occupied[size_t(k)].data(), margin[size_t(k)], b);
                         float* accD = layers[size_t(k)].accD.data();
                         for (int j = 0; j < b.n; ++j)
                             if (b.cell[j] >= 0) accD[b.cell[j]] += 1.f;
@@ -2311,7 +2450,7 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                             const float qx = s.x + l.c * s.u, qy = s.y - l.c * s.v;
                             if (qx < box[0] || qy < box[1] || qx >= box[2] || qy >= box[3]) return;
                             if (!countEveryD) {
-                                const float dt = alongChord(s.t - 0.5f, l.depthRate), r = std::abs(dt) * spread + 2.f;
+                                const float dt = alongChord(s.t - 0.5f, l.depthRate), r = std::abs(dt) * spread + l.maxSag + 2.f;
                                 const float px = qx - dt * mean.x, py = qy - dt * mean.y;
                                 if (px < own[0] - r || py < own[1] - r || px >= own[2] + r || py >= own[3] + r) return;
                             }
@@ -2345,7 +2484,8 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                     l.accD = std::vector<float>();
                     l.buildCovered();
                     l.rayReach = std::max({std::abs(l.cMin), std::abs(l.cMax), std::abs(l.rayC), std::abs(l.rayC + l.rayC2)}) +
-                                 chordReach(l.depthRate) * std::max(std::sqrt(l.rayMx * l.rayMx + l.rayMy * l.rayMy), l.motionScale * l.maxMotion);
+                                 chordReach(l.depthRate) * std::max(std::sqrt(l.rayMx * l.rayMx + l.rayMy * l.rayMy), l.motionScale * l.maxMotion) +
+                                 l.maxSag;
                 }
                 // A layer a pixel's rays can see; a sharp still layer is the same for every ray
                 // (its pixel's cell), looked up once.
@@ -2472,7 +2612,9 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                                     // The layer's shear, then the slope of the surface it finds
                                     // there (one fixed-point step), shaped by the grid's blur.
                                     const bool follow = l.followsSlope(), moving = l.timeBins > 1;
-                                    partial |= follow ? (moving ? traceBlurred<true, true>(l, index, ray, j0, j1) : traceBlurred<true, false>(l, index, ray, j0, j1))
+                                    const bool arcs = moving && !l.sagGrid.empty() && !l.motionGrid.empty();
+                                    partial |= arcs ? (follow ? traceBlurred<true, true, true>(l, index, ray, j0, j1) : traceBlurred<false, true, true>(l, index, ray, j0, j1))
+                                             : follow ? (moving ? traceBlurred<true, true>(l, index, ray, j0, j1) : traceBlurred<true, false>(l, index, ray, j0, j1))
                                                       : (moving ? traceBlurred<false, true>(l, index, ray, j0, j1) : traceBlurred<false, false>(l, index, ray, j0, j1));
                                 }
                             }

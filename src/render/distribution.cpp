@@ -56,6 +56,13 @@ void exchangeLightField(const Distribution* d, LightFieldSamples& lf) {
             LightFieldSample* end = lf.run(stage, size_t(y + 1) * W);
             return std::pair<char*, size_t>{reinterpret_cast<char*>(begin), size_t(end - begin) * sizeof(LightFieldSample)};
         });
+    if (lf.curved())  // (the sagittas beside the samples)
+        for (int stage = 0; stage < lf.stages(); ++stage)
+            exchangeRows(d, lf.height(), [&](int y) {
+                LightFieldSag* begin = lf.sagRun(stage, size_t(y) * W);
+                LightFieldSag* end = lf.sagRun(stage, size_t(y + 1) * W);
+                return std::pair<char*, size_t>{reinterpret_cast<char*>(begin), size_t(end - begin) * sizeof(LightFieldSag)};
+            });
 }
 
 std::vector<uint64_t> gatherCounts(const Distribution* d, uint64_t mine) {

@@ -13,7 +13,8 @@ namespace {
 constexpr uint64_t kRenderBytesPerPixel = 1200;
 /// MAAF's --maaf-keep-records keeps every initial sample: 64 bytes each (SampleRecord).
 constexpr uint64_t kRecordBytes = 64;
-/// The layers keep every sample (core/light_field.h) until they reconstruct: 24 bytes each,
+/// The layers keep every sample (core/light_field.h) until they reconstruct: 24 bytes each (28
+/// where an object turns: keepsSags),
 /// within the 1200 a pixel the rest of their stage needs (measured, cornell's lens, mc at 32 spp,
 /// 256x256: 786 bytes a pixel with --layers off, 1647 with them on, 1968 estimated).
 constexpr uint64_t kLightFieldSampleBytes = sizeof(LightFieldSample);
@@ -33,7 +34,8 @@ RenderMemory renderMemory(const scene::SceneDesc& desc, const RenderOptions& opt
     }
     // At least the initial samples; the adaptive ones are checked as they are added.
     if (spp > 0 && keepsLightField(desc, options, spp)) {
-        perPixel += uint64_t(spp) * kLightFieldSampleBytes + sizeof(float);  // and LightFieldSamples::bentReach
+        perPixel += uint64_t(spp) * (kLightFieldSampleBytes + (keepsSags(desc) ? sizeof(LightFieldSag) : 0)) +
+                    sizeof(float);  // and LightFieldSamples::bentReach
         m.what += " keeping its " + std::to_string(spp) + " samples a pixel for the layers (--layers)";
     }
     m.bytes = pixels * perPixel;

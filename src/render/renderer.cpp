@@ -440,6 +440,10 @@ int renderSpp(const scene::SceneDesc& desc, const RenderOptions& options) {
     return options.spp.value_or(options.method == "mc" ? desc.render.spp : 16);
 }
 
+bool keepsSags(const scene::SceneDesc& desc) {
+    return std::any_of(desc.meshes.begin(), desc.meshes.end(), [](const scene::TriangleMesh& m) { return m.turnDegrees != 0.f; });
+}
+
 bool keepsLightField(const scene::SceneDesc& desc, const RenderOptions& options, int spp) {
     return options.layered(spp, desc.hasMotion()) && (desc.camera.apertureRadius > 0 || desc.hasMotion());
 }
@@ -467,7 +471,7 @@ RenderResult render(const scene::Scene& scene, const RenderOptions& options) {
     if (options.layers != "auto" && options.layers != "on" && options.layers != "off")
         throw Error("--layers", "expected auto, on or off, got '" + options.layers + "'");
     const bool layered = keepsLightField(desc, options, spp);
-    if (layered) lightField = LightFieldSamples(desc.camera.width, desc.camera.height);
+    if (layered) lightField = LightFieldSamples(desc.camera.width, desc.camera.height, keepsSags(desc));
     MethodContext ctx{scene, options, sampler, sampler.view(), spp, layered ? &lightField : nullptr};
 
     RenderResult result;

@@ -124,6 +124,9 @@ int renderSpp(const scene::SceneDesc& desc, const RenderOptions& options);
 /// the options reconstruct with layers at `spp` and there is something to reconstruct across
 /// pixels, a lens or motion (without either every layer is sharp: each pixel's own samples).
 bool keepsLightField(const scene::SceneDesc& desc, const RenderOptions& options, int spp);
+/// Whether a kept light field keeps its samples' sagittas too (LightFieldSag, 4 bytes a sample):
+/// where an object of the scene turns (TracedSample::sag).
+bool keepsSags(const scene::SceneDesc& desc);
 
 RenderResult render(const scene::Scene& scene, const RenderOptions& options);
 

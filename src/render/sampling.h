@@ -39,6 +39,7 @@ public:
         const size_t p = size_t(y) * m_lf->width() + x;
         if (m_fill[p] == m_lf->runLength(m_stage, p)) return;
         const SampleRecord& r = s.record;
+        if (m_lf->curved()) m_lf->sagRun(m_stage, p)[m_fill[p]] = LightFieldSag::pack(s.sag);
         m_lf->run(m_stage, p)[m_fill[p]++] = LightFieldSample::pack(
             s.film, r.lens, s.time, s.hit ? s.depth : kInf, s.motion, s.albedo, s.albedo * (r.direct + r.indirect), slot);
         // A bent path on a surface that turns towards or away from the camera (render/renderer.cpp,
