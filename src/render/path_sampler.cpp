@@ -317,8 +317,9 @@ void PathSampler::traceMany(const SampleRun* runs, size_t nRuns, bool span) cons
                     const float chord = std::sqrt(o.motion.x * o.motion.x + o.motion.y * o.motion.y);
                     o.bend = chord > 1e-3f ? std::abs(ox * o.motion.y - oy * o.motion.x) / chord : std::sqrt(ox * ox + oy * oy);
                     // The sagitta for the layers' curved trajectories (TracedSample::sag), where
-                    // the object turns in depth by at most kCurvedTurnInDepth.
-                    if (m && m->turns()) {
+                    // the object turns by at most half a turn, and in depth by at most
+                    // kCurvedTurnInDepth.
+                    if (m && m->turns() && std::abs(m->radians) <= kPi) {
                         const Vec3f view = normalize(atMid - m_camera.poseAt(0.5f).position);
                         if (std::abs(m->radians) * length(cross(m->axis, view)) <= kCurvedTurnInDepth) o.sag = {ox, oy};
                     }

@@ -29,6 +29,9 @@ class Distribution;
 /// (docs/layers.md, "Curved trajectories"): docs/bunny-turn.json's bunny turning 40 degrees
 /// -13% and -14% (two seeds), 60 degrees -12% and -14%, 90 degrees +19% and +28%;
 /// docs/turning-room.json (a bunny turning 60 degrees, a box 120 about a diagonal) -6%.
+/// (And only turns of at most half a turn in all: beyond, the arc runs past its chord's ends,
+/// which no parabola through them and its middle follows; a bar spinning 200 degrees in the
+/// image plane measured +11% curved.)
 constexpr float kCurvedTurnInDepth = 1.0471976f;  // 60 degrees
 
 /// Everything one path sample produced: the record the filters see, plus the per-sample facts
@@ -53,7 +56,7 @@ struct TracedSample {
     // its normal and the direction to the camera. A spin in the image plane (a fan, a wheel
     // seen face on) turns nothing towards the camera.
     float faceTurn = 0;
-    // On an object turning in depth by at most kCurvedTurnInDepth: where its hit is at
+    // On an object turning by at most half a turn, in depth by at most kCurvedTurnInDepth: where its hit is at
     // mid-shutter on the screen, off its chord's middle (pixels; the arc's sagitta, along the
     // chord as well as across it). The layered reconstruction reprojects the sample along the
     // parabola through the chord's ends and that point (filter/layers.cpp, curvedShift). 0
