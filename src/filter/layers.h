@@ -14,11 +14,11 @@
 // surface collapse there onto a sharp image, so samples of many pixels can be reused. (For a
 // surface moving in depth, t - 1/2 is replaced by the share of its chord m a point moving at
 // constant velocity in space covers by then, which is not proportional to the time under
-// perspective: layers.cpp, alongChord. A point of an object turning (by at most half a turn) in depth by at most 60
-// degrees moves along the parabola through its chord's ends and its place at mid-shutter, which
-// its sample records as the sagitta s: its y gains 4 e (t - 1/2)^2, e = s less what alongChord
-// gives; a moving layer's motion grid holds the mean e beside the motion: layers.cpp,
-// curvedShift.)
+// perspective: layers.cpp, alongChord. A point of an object turning by at most half a turn,
+// and in depth by at most 60 degrees, moves along the parabola through its chord's ends and its
+// place at mid-shutter, which its sample records as the sagitta s: its y gains 4 e (t - 1/2)^2,
+// e = s less what alongChord gives; a moving layer's motion grid holds the mean e beside the
+// motion: layers.cpp, curvedShift.)
 //
 // Per screen tile (64 pixels, with an apron as wide as the trajectories that reach it, at most
 // LayerOptions::maxReach):
