@@ -103,7 +103,9 @@ static_assert(sizeof(LightFieldSample) == 24);
 struct LightFieldSag {
     int16_t x = 0, y = 0;
     static LightFieldSag pack(Vec2f sag) {
-        auto q = [](float v) { return int16_t(std::lround(std::clamp(v, -LightFieldSample::kMaxMotion, LightFieldSample::kMaxMotion) * 8.f)); };
+        auto q = [](float v) {  // (NaN -> 0, as LightFieldSample::pack)
+            return !std::isnan(v) ? int16_t(std::lround(std::clamp(v, -LightFieldSample::kMaxMotion, LightFieldSample::kMaxMotion) * 8.f)) : int16_t(0);
+        };
         return {q(sag.x), q(sag.y)};
     }
     Vec2f unpack() const { return {float(x) / 8.f, float(y) / 8.f}; }
