@@ -224,10 +224,11 @@ inline Vec2f layerPosition(const Gathered& s, bool sharp, float c, float mx, flo
 /// Along the chord alone a sample taken at the open or the close of the shutter landed up to
 /// |s| from its point's mid-shutter place, and a turning bunny's silhouette, whose points move
 /// in depth there, came out sharp and 2 px wide of its blurred edge (docs/layers.md, "Curved
-/// trajectories"). Where a sample lies in its own layer's sharp image: its shear plus this.
-inline Vec2f curvedShift(const Gathered& s, float g) {
-    const float d = s.t - 0.5f, k = 4.f * d * d;
-    return {k * (s.sx - 0.25f * g * s.mx), k * (s.sy - 0.25f * g * s.my)};
+/// trajectories"). Where a sample taken at time t with effective sagitta e lies in its own
+/// layer's sharp image: its shear plus this.
+inline Vec2f curvedShift(Vec2f e, float t) {
+    const float d = t - 0.5f, k = 4.f * d * d;
+    return {k * e.x, k * e.y};
 }
 /// The effective sagitta e of a sample in a layer of depth rate g (curvedShift).
 inline Vec2f effectiveSag(const Gathered& s, float g) { return {s.sx - 0.25f * g * s.mx, s.sy - 0.25f * g * s.my}; }
@@ -1191,18 +1192,21 @@ struct Bilinear {
     const int c00 = j0 * l.gw + i0;
     return {{c00, c00 + 1, c00 + l.gw, c00 + l.gw + 1}, {(1 - ax) * (1 - ay), ax * (1 - ay), (1 - ax) * ay, ax * ay}};
 }
-/// The AffineMotion of a motion grid's unsmoothed sums (per cell: count, sum of mx, sum of my;
-/// gw x gh cells of 1 pixel), the fit's positions at the cells' centres; `fallback` (with no
-/// gradient) where the samples do not span two dimensions.
-AffineMotion fitMotion(const std::vector<float>& acc, int gw, int gh, Vec2f fallback) {
+/// The AffineMotion of a grid's unsmoothed sums of 2-vectors (gw x gh cells of 1 pixel; cell i's
+/// count at count[i cs], its sums of x and y at sums[i ss] and sums[i ss + 1]: a motion grid's
+/// count, sum of mx, sum of my, or a turning layer's sagittas beside that count), the fit's
+/// positions at the cells' centres; `fallback` (with no gradient) where the samples do not span
+/// two dimensions.
+AffineMotion fitMotion(const float* count, int cs, const float* sums, int ss, int gw, int gh, Vec2f fallback) {
     double w = 0, sx = 0, sy = 0, sxx = 0, sxy = 0, syy = 0, smx = 0, smy = 0, sxmx = 0, symx = 0, sxmy = 0, symy = 0;
     for (int j = 0; j < gh; ++j)
         for (int i = 0; i < gw; ++i) {
-            const float* m = &acc[(size_t(j) * gw + i) * 3];
-            if (!(m[0] > 0.f)) continue;
-            const double n = m[0], x = i + 0.5, y = j + 0.5;
+            const size_t c = size_t(j) * gw + i;
+            const float n0 = count[c * cs], m1 = sums[c * ss], m2 = sums[c * ss + 1];
+            if (!(n0 > 0.f)) continue;
+            const double n = n0, x = i + 0.5, y = j + 0.5;
             w += n, sx += n * x, sy += n * y, sxx += n * x * x, sxy += n * x * y, syy += n * y * y;
-            smx += m[1], smy += m[2], sxmx += x * m[1], symx += y * m[1], sxmy += x * m[2], symy += y * m[2];
+            smx += m1, smy += m2, sxmx += x * m1, symx += y * m1, sxmy += x * m2, symy += y * m2;
         }
     AffineMotion fit;
     fit.mean = fallback;
@@ -1218,6 +1222,30 @@ AffineMotion fitMotion(const std::vector<float>& acc, int gw, int gh, Vec2f fall
     fit.b00 = float((cxmx * cyy - cymx * cxy) / det), fit.b01 = float((cymx * cxx - cxmx * cxy) / det);
     fit.b10 = float((cxmy * cyy - cymy * cxy) / det), fit.b11 = float((cymy * cxx - cxmy * cxy) / det);
     return fit;
+}
+
+/// A layer's grid of mean 2-vectors (motionGrid, sagGrid: x and y per cell) from its smoothed
+/// counts and sums (as fitMotion reads them): a cell's mean where its count is at least 0.05,
+/// else (no samples there) `fit` at the cell, within the largest distance from the fit's mean
+/// of the means seen.
+void meanVectorGrid(const float* count, int cs, const float* sums, int ss, int gw, int gh, const AffineMotion& fit,
+                    std::vector<float>& grid) {
+    const size_t cells = size_t(gw) * gh;
+    grid.resize(cells * 2);
+    float deviation = 0;
+    for (size_t i = 0; i < cells; ++i) {
+        const float n = count[i * cs];
+        if (n < 0.05f) continue;
+        grid[2 * i] = sums[i * ss] / n, grid[2 * i + 1] = sums[i * ss + 1] / n;
+        deviation = std::max(deviation, sqr(grid[2 * i] - fit.mean.x) + sqr(grid[2 * i + 1] - fit.mean.y));
+    }
+    deviation = std::sqrt(deviation);
+    for (size_t i = 0; i < cells; ++i) {
+        if (!(count[i * cs] < 0.05f)) continue;
+        const Vec2f p{float(i % size_t(gw)) + 0.5f, float(i / size_t(gw)) + 0.5f};
+        const Vec2f v = fit.at(p, deviation);
+        grid[2 * i] = v.x, grid[2 * i + 1] = v.y;
+    }
 }
 
 /// A grid of 2-vectors (a layer's motionGrid or sagGrid, x and y per cell) at a bilinear lookup.
@@ -1293,13 +1321,18 @@ struct Rays {
 /// of their cost (docs/layers.md, "A held-out bunny moving through slats").
 /// (`f` is the layer's motionFit, copied by the caller out of its SIMD loop: read through the
 /// layer under the loop's condition, its loads kept the moving rays' loop from vectorising.)
+/// (The solve of motionShift and curvedMotionShift: p = A^-1 r, returned as q - p.)
+[[gnu::always_inline]] inline Vec2f solveShift(float a00, float a01, float a10, float a11, float rx, float ry, float qx, float qy,
+                                               Vec2f fallback) {
+    const float det = a00 * a11 - a01 * a10;
+    const bool solvable = det > 0.2f;  // (a fit that folds the layer over itself within the shutter: the mean motion's shift)
+    return {solvable ? qx - (a11 * rx - a01 * ry) / det : fallback.x, solvable ? qy - (a00 * ry - a10 * rx) / det : fallback.y};
+}
 [[gnu::always_inline]] inline Vec2f motionShift(const AffineMotion& f, float qx, float qy, float s, Vec2f fallback) {
     const float a00 = 1.f + s * f.b00, a01 = s * f.b01, a10 = s * f.b10, a11 = 1.f + s * f.b11;
     const float rx = qx - s * (f.mean.x - (f.b00 * f.centre.x + f.b01 * f.centre.y));
     const float ry = qy - s * (f.mean.y - (f.b10 * f.centre.x + f.b11 * f.centre.y));
-    const float det = a00 * a11 - a01 * a10;
-    const bool solvable = det > 0.2f;  // (a fit that folds the layer over itself within the shutter: the mean motion's shift)
-    return {solvable ? qx - (a11 * rx - a01 * ry) / det : fallback.x, solvable ? qy - (a00 * ry - a10 * rx) / det : fallback.y};
+    return solveShift(a00, a01, a10, a11, rx, ry, qx, qy, fallback);
 }
 
 /// motionShift on a turning layer's arcs (Layer::sagGrid): the point p of the sharp image with
@@ -1311,9 +1344,7 @@ struct Rays {
     const float a00 = 1.f + s * f.b00 - k * e.b00, a01 = s * f.b01 - k * e.b01, a10 = s * f.b10 - k * e.b10, a11 = 1.f + s * f.b11 - k * e.b11;
     const float rx = qx - s * (f.mean.x - (f.b00 * f.centre.x + f.b01 * f.centre.y)) + k * (e.mean.x - (e.b00 * e.centre.x + e.b01 * e.centre.y));
     const float ry = qy - s * (f.mean.y - (f.b10 * f.centre.x + f.b11 * f.centre.y)) + k * (e.mean.y - (e.b10 * e.centre.x + e.b11 * e.centre.y));
-    const float det = a00 * a11 - a01 * a10;
-    const bool solvable = det > 0.2f;
-    return {solvable ? qx - (a11 * rx - a01 * ry) / det : fallback.x, solvable ? qy - (a00 * ry - a10 * rx) / det : fallback.y};
+    return solveShift(a00, a01, a10, a11, rx, ry, qx, qy, fallback);
 }
 
 /// Rays [j0, j1) through a blurred layer (the `index`-th a pixel's rays see): the layer's lens
@@ -1336,14 +1367,15 @@ bool traceBlurred(const Layer& l, int index, Rays& ray, int j0, int j1) {
         const float dt = ray.dt[j];
         const float shaped = dt * (1.f + l.rayT2 * 4.f * dt * dt);
         const float st = alongChord(shaped, l.depthRate);
+        // (kCurved: 4 tau^2, tau the ray's shutter offset as its motion is scaled: curvedShift.)
+        const float tau = l.motionScale * shaped, arcK = 4.f * tau * tau;
         float mox = l.rayMx * st, moy = l.rayMy * st;
         float cRay = l.rayC + l.rayC2 * ray.u2[j];
         if (followMotion) {
             Vec2f shift;
             if constexpr (kCurved) {
-                const float tau = l.motionScale * shaped;
-                shift = curvedMotionShift(fit, sagFit, ray.px[j] + cRay * ray.ux[j], ray.py[j] - cRay * ray.uy[j], l.motionScale * st,
-                                          4.f * tau * tau, {mox, moy});
+                shift = curvedMotionShift(fit, sagFit, ray.px[j] + cRay * ray.ux[j], ray.py[j] - cRay * ray.uy[j], l.motionScale * st, arcK,
+                                          {mox, moy});
             } else {
                 shift = motionShift(fit, ray.px[j] + cRay * ray.ux[j], ray.py[j] - cRay * ray.uy[j], l.motionScale * st, {mox, moy});
             }
@@ -1367,10 +1399,10 @@ bool traceBlurred(const Layer& l, int index, Rays& ray, int j0, int j1) {
                     moy = l.motionScale * m.y * st;
                     if constexpr (kCurved) {
                         // On its arc (curvedShift): the point it finds there is 4 e tau^2 back
-                        // towards its mid-shutter place, tau the ray's shutter offset as its
-                        // motion is scaled; then a second step, the motion and the sagitta where
-                        // the first put it (the sagitta moves the lookup by up to its length).
-                        const float tau = l.motionScale * shaped, k = 4.f * tau * tau;
+                        // towards its mid-shutter place; then a second step, the motion and the
+                        // sagitta where the first put it (the sagitta moves the lookup by up to
+                        // its length).
+                        const float k = arcK;
                         const Vec2f e = sagAt(l, b);
                         mox -= k * e.x;
                         moy -= k * e.y;
@@ -1635,7 +1667,6 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
         // The D pass of the layers with a motion grid (withGrid): per layer, its cells with
         // samples summed over rectangles, its margin, and the samples behind it, a batch at a time.
         std::vector<int> withGrid, margin;
-        std::vector<float> sagFitIn;  // a turning layer's counts and sagitta sums, for its fit
         std::vector<std::array<float, 4>> reachBox, ownBox;
         std::vector<std::vector<int>> occupied;
         std::vector<MotionBatch> batch;
@@ -2177,8 +2208,9 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                     // (A turning object's sample on its arc: only in a layer with a motion grid,
                     // whose rays and D follow the grid's sagittas.)
                     const bool arc = l.motion && curved(s);
+                    const Vec2f e = arc ? effectiveSag(s, l.depthRate) : Vec2f{0.f, 0.f};
                     if (arc) {
-                        const Vec2f shift = curvedShift(s, l.depthRate);
+                        const Vec2f shift = curvedShift(e, s.t);
                         own = {own.x + shift.x, own.y + shift.y};
                     }
                     const int ci = l.cellIndex(own);
@@ -2186,7 +2218,6 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                     if (arc) {
                         std::vector<float>& sa = sagAcc[size_t(sl)];
                         if (sa.empty()) sa.assign(size_t(l.gw) * l.gh * 2, 0.f);
-                        const Vec2f e = effectiveSag(s, l.depthRate);
                         sa[size_t(ci) * 2] += e.x;
                         sa[size_t(ci) * 2 + 1] += e.y;
                     }
@@ -2292,75 +2323,36 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                     for (size_t k = 0; k < layers.size(); ++k) {
                         if (motionAcc[k].empty()) continue;
                         Layer& l = layers[k];
-                        const AffineMotion fit = fitMotion(motionAcc[k], l.gw, l.gh, Vec2f{l.mx, l.my});
+                        const float* sums = motionAcc[k].data();  // (per cell: count, sum of mx, sum of my)
+                        const AffineMotion fit = fitMotion(sums, 3, sums + 1, 3, l.gw, l.gh, Vec2f{l.mx, l.my});
                         l.motionFit = fit;
                         l.motionFit.centre = {fit.centre.x + float(l.gx0), fit.centre.y + float(l.gy0)};
-                        // (A turning layer's sagittas fitted likewise, before the sums are smoothed.)
-                        AffineMotion sagFit;
-                        if (!sagAcc[k].empty()) {
-                            std::vector<float>& fitIn = local.sagFitIn;
-                            fitIn.resize(size_t(l.gw) * l.gh * 3);
-                            for (size_t i = 0; i < size_t(l.gw) * l.gh; ++i)
-                                fitIn[i * 3] = motionAcc[k][i * 3], fitIn[i * 3 + 1] = sagAcc[k][i * 2], fitIn[i * 3 + 2] = sagAcc[k][i * 2 + 1];
-                            sagFit = fitMotion(fitIn, l.gw, l.gh, Vec2f{0.f, 0.f});
-                            l.sagFit = sagFit;
-                            l.sagFit.centre = {sagFit.centre.x + float(l.gx0), sagFit.centre.y + float(l.gy0)};
-                        }
+                        // (A turning layer's effective sagittas fitted likewise, over the same count,
+                        // before the sums are smoothed.)
+                        const bool turning = !sagAcc[k].empty();
+                        const AffineMotion sagFit = turning ? fitMotion(sums, 3, sagAcc[k].data(), 2, l.gw, l.gh, Vec2f{0.f, 0.f}) : AffineMotion{};
+                        l.sagFit = sagFit;
+                        l.sagFit.centre = {sagFit.centre.x + float(l.gx0), sagFit.centre.y + float(l.gy0)};
+                        // The mean motion per cell, and where the layer turns the mean effective
+                        // sagitta, the sums smoothed alike and over the same (smoothed) count.
                         smooth(motionAcc[k], l.gw, l.gh, 3, l.sigmaX(l.sigma), l.sigmaY(l.sigma));
-                        l.motionGrid.resize(size_t(l.gw) * l.gh * 2);
-                        const size_t cells = size_t(l.gw) * l.gh;
-                        float deviation = 0;  // the largest |cell's motion - the fit's mean| where there are samples
-                        for (size_t i = 0; i < cells; ++i) {
-                            float* m = &motionAcc[k][i * 3];
-                            if (m[0] < 0.05f) continue;
-                            m[1] /= m[0], m[2] /= m[0];
-                            deviation = std::max(deviation, sqr(m[1] - fit.mean.x) + sqr(m[2] - fit.mean.y));
-                        }
-                        deviation = std::sqrt(deviation);
+                        const float* count = motionAcc[k].data();  // (smoothed)
+                        meanVectorGrid(count, 3, count + 1, 3, l.gw, l.gh, fit, l.motionGrid);
                         float reach = 0, spread = 0;
-                        for (size_t i = 0; i < cells; ++i) {
-                            float* m = &motionAcc[k][i * 3];
-                            if (m[0] < 0.05f) {
-                                // No samples here: the fit, within the spread of the motions seen.
-                                const Vec2f p{float(i % size_t(l.gw)) + 0.5f, float(i / size_t(l.gw)) + 0.5f};
-                                const Vec2f m1 = fit.at(p, deviation);
-                                m[1] = m1.x, m[2] = m1.y;
-                            }
-                            l.motionGrid[2 * i] = m[1];
-                            l.motionGrid[2 * i + 1] = m[2];
-                            reach = std::max(reach, m[1] * m[1] + m[2] * m[2]);
-                            spread = std::max(spread, sqr(m[1] - fit.mean.x) + sqr(m[2] - fit.mean.y));
+                        for (size_t i = 0; i < l.motionGrid.size(); i += 2) {
+                            const float mx = l.motionGrid[i], my = l.motionGrid[i + 1];
+                            reach = std::max(reach, mx * mx + my * my);
+                            spread = std::max(spread, sqr(mx - fit.mean.x) + sqr(my - fit.mean.y));
                         }
                         l.maxMotion = std::sqrt(reach);
                         l.motionSpread = std::sqrt(spread);
-                        // The mean effective sagitta per cell: the sums smoothed as the motion's,
-                        // over the same (smoothed) count.
                         l.sagGrid.clear();
                         l.maxSag = 0;
-                        if (!sagAcc[k].empty()) {
+                        if (turning) {
                             smooth(sagAcc[k], l.gw, l.gh, 2, l.sigmaX(l.sigma), l.sigmaY(l.sigma));
-                            l.sagGrid.resize(cells * 2);
-                            float sagDeviation = 0;  // (as the motion's: the fit within the spread seen)
-                            for (size_t i = 0; i < cells; ++i) {
-                                const float n = motionAcc[k][i * 3];
-                                if (n >= 0.05f)
-                                    sagDeviation = std::max(sagDeviation, sqr(sagAcc[k][i * 2] / n - sagFit.mean.x) + sqr(sagAcc[k][i * 2 + 1] / n - sagFit.mean.y));
-                            }
-                            sagDeviation = std::sqrt(sagDeviation);
+                            meanVectorGrid(count, 3, sagAcc[k].data(), 2, l.gw, l.gh, sagFit, l.sagGrid);
                             float most = 0;
-                            for (size_t i = 0; i < cells; ++i) {
-                                const float n = motionAcc[k][i * 3];
-                                Vec2f e;
-                                if (n >= 0.05f) {
-                                    e = {sagAcc[k][i * 2] / n, sagAcc[k][i * 2 + 1] / n};
-                                } else {
-                                    const Vec2f p{float(i % size_t(l.gw)) + 0.5f, float(i / size_t(l.gw)) + 0.5f};
-                                    e = sagFit.at(p, sagDeviation);
-                                }
-                                l.sagGrid[2 * i] = e.x;
-                                l.sagGrid[2 * i + 1] = e.y;
-                                most = std::max(most, e.x * e.x + e.y * e.y);
-                            }
+                            for (size_t i = 0; i < l.sagGrid.size(); i += 2) most = std::max(most, sqr(l.sagGrid[i]) + sqr(l.sagGrid[i + 1]));
                             l.maxSag = std::sqrt(most);
                         }
                     }
