@@ -257,6 +257,54 @@ TEST(Layers, TheDsSkippedFarFromALayersOwnSamplesChangeNoImage) {
         }
 }
 
+TEST(Layers, TheCellsBeyondALayersAccumulationsChangeNoImage) {
+    // A defocused post in front (slope +5 px), a box moving diagonally near the focus (a motion
+    // grid), a strip moving sideways in focus (a crisp axis), a disc turning as it moves (its
+    // samples on arcs: a sagitta grid), a disc in focus and a far wall (-4 px), each sample of
+    // its own random radiance. The stage smooths and resolves each layer's grids only within the
+    // cells its accumulations can reach (CellBox), and the image must be the one that works on
+    // every cell, to the bit. (It fails with the motion grid's sums smoothed over an empty box,
+    // as before the box of its counts was known, or with a Gaussian's box not grown along y.)
+    const int W = 192, H = 128;
+    const ViewGeometry view = wideLensView(W, H);
+    LightFieldSamples lf(W, H, true);
+    const int stage = lf.addStage([&](size_t) { return 12u; });
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<float> uni(0.f, 1.f);
+    for (int y = 0; y < H; ++y)
+        for (int x = 0; x < W; ++x) {
+            LightFieldSample* run = lf.run(stage, size_t(y) * W + x);
+            LightFieldSag* sags = lf.sagRun(stage, size_t(y) * W + x);
+            for (int k = 0; k < 12; ++k) {
+                const Vec2f film{uni(rng), uni(rng)}, lens = concentricDisc(uni(rng), uni(rng));
+                const float t = uni(rng), fx = float(x) + film.x, fy = float(y) + film.y;
+                const bool post = fx + 5.f * lens.x > 60.f && fx + 5.f * lens.x < 75.f;
+                const bool box = !post && std::abs(fx - 30.f * (t - 0.5f) - 140.f) < 12.f && std::abs(fy - 12.f * (t - 0.5f) - 90.f) < 15.f;
+                const bool strip = !post && !box && std::abs(fx - 24.f * (t - 0.5f) - 110.f) < 8.f && std::abs(fy - 30.f) < 10.f;
+                const float ax = fx - 20.f * (t - 0.5f) - 30.f, ay = fy - 4.f * (1.f - 4.f * sqr(t - 0.5f)) - 95.f;
+                const bool turning = !post && !box && !strip && ax * ax + ay * ay < 150.f;
+                const bool disc = !post && !box && !strip && !turning && (x - 40) * (x - 40) + (y - 40) * (y - 40) < 300;
+                const float depth = post ? 1.f : box ? 1.9f : strip ? 2.f : turning ? 1.95f : disc ? 2.f : 10.f;
+                const Vec2f motion = box ? Vec2f{30.f, 12.f} : strip ? Vec2f{24.f, 0.f} : turning ? Vec2f{20.f, 0.f} : Vec2f{0.f, 0.f};
+                run[k] = LightFieldSample::pack(film, lens, t, depth, motion, Vec3f(1.f), Vec3f(uni(rng), uni(rng), uni(rng)),
+                                                post ? 1 : 0);
+                sags[k] = LightFieldSag::pack(turning ? Vec2f{0.f, 4.f} : Vec2f{0.f, 0.f});
+            }
+        }
+    filter::LayerStats stats;
+    filter::LayerOptions boxed, everyCell;
+    everyCell.everyCell = true;
+    const Image3f a = filter::reconstructLayers(filter::LayerInput{lf, view, {}}, boxed, &stats);
+    const Image3f b = filter::reconstructLayers(filter::LayerInput{lf, view, {}}, everyCell, nullptr);
+    EXPECT_GT(stats.layersPerTile, 2.0);
+    EXPECT_GT(stats.blurredTiles, 0.5);
+    for (int y = 0; y < H; ++y)
+        for (int x = 0; x < W; ++x) {
+            ASSERT_TRUE(isFinite(a(x, y))) << x << ", " << y;
+            ASSERT_EQ(std::memcmp(&a(x, y), &b(x, y), sizeof(Vec3f)), 0) << x << ", " << y;
+        }
+}
+
 TEST(Layers, WhereAFilteredLightIsAnotherPointsASampleCarriesItsOwn) {
     // One plane filling the view, every sample of own radiance 0.5; the filtered light of the
     // primary surface is 0.2, of the others 0.9 (albedo 1). In a blurred still layer a sample on

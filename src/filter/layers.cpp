@@ -274,6 +274,52 @@ void summedArea(int gw, int gh, std::vector<int>& sat, Has&& has) {
     }
 }
 
+/// Grid cells [x0, x1) x [y0, y1) (empty where x0 >= x1 or y0 >= y1): where a layer's
+/// accumulations can be non-zero. Its passes (smoothRun, smoothAcrossEdges, resolveCells) work
+/// within it and leave the rest of the grid as it is: zero, or what every empty cell resolves to.
+/// A blurred layer's grid is its tile and a margin as wide as its blur reaches, and its samples
+/// fill a part of it (an object, a slat): on docs/many-motion.json 4% of its cells, 9% of them
+/// with a D; conference at 512x512 35% (docs/layers.md, "Empty cells").
+struct CellBox {
+    int x0 = 0, y0 = 0, x1 = 0, y1 = 0;
+    bool empty() const { return x0 >= x1 || y0 >= y1; }
+    /// Grown by rx cells each way along x and ry along y, within a gw x gh grid.
+    CellBox grown(int rx, int ry, int gw, int gh) const {
+        if (empty()) return *this;
+        return {std::max(0, x0 - rx), std::max(0, y0 - ry), std::min(gw, x1 + rx), std::min(gh, y1 + ry)};
+    }
+    CellBox united(const CellBox& b) const {
+        if (empty()) return b;
+        if (b.empty()) return *this;
+        return {std::min(x0, b.x0), std::min(y0, b.y0), std::max(x1, b.x1), std::max(y1, b.y1)};
+    }
+};
+/// The box of the cells a summed-area table (summedArea) counts, from its last row (per column)
+/// and last column (per row).
+CellBox summedBox(const std::vector<int>& sat, int gw, int gh) {
+    const int* lastRow = &sat[size_t(gh) * (gw + 1)];
+    CellBox b{gw, gh, 0, 0};
+    for (int i = 0; i < gw; ++i)
+        if (lastRow[i + 1] > lastRow[i]) b.x0 = std::min(b.x0, i), b.x1 = i + 1;
+    for (int j = 0; j < gh; ++j)
+        if (sat[size_t(j + 1) * (gw + 1) + gw] > sat[size_t(j) * (gw + 1) + gw]) b.y0 = std::min(b.y0, j), b.y1 = j + 1;
+    return b.empty() ? CellBox{} : b;
+}
+/// The box of the cells of a grid (gw x gh cells of `stride` channels) whose first channel is not zero.
+CellBox nonZeroBox(const std::vector<float>& grid, int gw, int gh, int stride = 1) {
+    CellBox b{gw, gh, 0, 0};
+    for (int j = 0; j < gh; ++j) {
+        const float* row = &grid[size_t(j) * gw * stride];
+        int first = 0;
+        while (first < gw && row[size_t(first) * stride] == 0.f) ++first;
+        if (first == gw) continue;
+        int last = gw - 1;
+        while (row[size_t(last) * stride] == 0.f) --last;
+        b.x0 = std::min(b.x0, first), b.x1 = std::max(b.x1, last + 1), b.y0 = std::min(b.y0, j), b.y1 = j + 1;
+    }
+    return b.empty() ? CellBox{} : b;
+}
+
 struct Layer {
     double sumC = 0, sumMx = 0, sumMy = 0, sumM2 = 0, sumInvDepth = 0;  // sumM2: of |motion|^2
     float cMin = kInf, cMax = -kInf;
@@ -380,6 +426,9 @@ struct Layer {
     // (accD): every sample behind the layer adds to it, at scattered cells, and a 4-byte cell
     // keeps those writes in cache (a moving layer's accumulated cell is 136 bytes).
     std::vector<float> acc, accD, cell;
+    // Where acc can be non-zero: its cells with N > 0, since a sample adds to every channel at
+    // one cell (CellBox; set by the D passes, which count those cells anyway).
+    CellBox accBox;
     /// Summed-area table of the cells with alpha > 0 ((gw + 1) x (gh + 1)): a pixel whose rays
     /// can reach only uncovered cells skips the layer (exactly: it would add nothing there).
     std::vector<int> covered;
@@ -931,65 +980,73 @@ std::vector<float> gaussianTaps(float sigma) {
 /// [c0, c1) of the `stride` interleaved channels of `acc` (gw x gh); c1 < 0: to the last. kChannels > 0: c1 - c0 known at compile
 /// time (the common runs, a still layer's and a moving one's: the loops over channels unrolled
 /// and vectorised; the same sums in the same order, so the same bytes as the general loop).
+/// `box`: where those channels can be non-zero (CellBox); returns where they can be after.
 template <int kChannels>
-void smoothRun(std::vector<float>& acc, int gw, int gh, int stride, float sigma, float sigmaY, int c0, int c1) {
+CellBox smoothRun(std::vector<float>& acc, int gw, int gh, int stride, float sigma, float sigmaY, int c0, int c1, CellBox box) {
     const int n = kChannels > 0 ? kChannels : c1 - c0;
     const std::vector<float> w = gaussianTaps(sigma), wy = gaussianTaps(sigmaY);
     const int r = int(w.size() / 2), ry = int(wy.size() / 2);
-    const size_t cells = size_t(gw) * gh;
-    std::vector<float> tmp(cells * n, 0.f);
+    if (box.empty()) return box;
+    // The horizontal pass's output, over the box's rows and its columns grown by r (the other
+    // cells' sums are of zeros).
+    const CellBox out = box.grown(r, ry, gw, gh);
+    const int tx0 = out.x0, tw = out.x1 - out.x0;
+    std::vector<float> tmp(size_t(box.y1 - box.y0) * tw * n, 0.f);  // (row j - box.y0, column i - tx0)
     // Per row, the columns [lo, hi) the horizontal pass can make non-zero: within r of its cells
     // with a non-zero channel (empty: lo = hi). A layer's samples cover a part of its grid (an
     // object, a slat), and elsewhere the sums only add zeros: skipped, the same sums.
     // (Found from each end of the row, not by reading all of it: a row a layer covers is read
     // a few cells deep; the scan was 2% of an MC render of raster-pan.)
     std::vector<int> lo(size_t(gh), 0), hi(size_t(gh), 0);
-    for (int j = 0; j < gh; ++j) {
+    for (int j = box.y0; j < box.y1; ++j) {
         auto any = [&](int i) {
             const float* in = &acc[(size_t(j) * gw + i) * stride + c0];
             bool nonZero = false;
             for (int ch = 0; ch < n; ++ch) nonZero |= in[ch] != 0.f;
             return nonZero;
         };
-        int first = 0;
-        while (first < gw && !any(first)) ++first;
-        if (first == gw) continue;
-        int last = gw - 1;
+        int first = box.x0;
+        while (first < box.x1 && !any(first)) ++first;
+        if (first == box.x1) continue;
+        int last = box.x1 - 1;
         while (!any(last)) --last;
         lo[size_t(j)] = std::max(0, first - r), hi[size_t(j)] = std::min(gw, last + r + 1);
     }
-    for (int j = 0; j < gh; ++j)
+    for (int j = box.y0; j < box.y1; ++j)
         for (int i = lo[size_t(j)]; i < hi[size_t(j)]; ++i) {
-            float* out = &tmp[(size_t(j) * gw + i) * n];
+            float* o = &tmp[(size_t(j - box.y0) * tw + size_t(i - tx0)) * n];
             for (int k = std::max(-r, -i); k <= std::min(r, gw - 1 - i); ++k) {
                 const float* in = &acc[(size_t(j) * gw + i + k) * stride + c0];
                 const float wk = w[k + r];
-                for (int ch = 0; ch < n; ++ch) out[ch] += wk * in[ch];
+                for (int ch = 0; ch < n; ++ch) o[ch] += wk * in[ch];
             }
         }
-    for (size_t q = 0; q < cells; ++q) std::fill_n(&acc[q * stride + c0], n, 0.f);
-    for (int j = 0; j < gh; ++j)
+    // (Zeroed where a row can be non-zero: elsewhere it is.)
+    for (int j = box.y0; j < box.y1; ++j)
+        for (int i = lo[size_t(j)]; i < hi[size_t(j)]; ++i) std::fill_n(&acc[(size_t(j) * gw + i) * stride + c0], n, 0.f);
+    for (int j = out.y0; j < out.y1; ++j)
         for (int k = std::max(-ry, -j); k <= std::min(ry, gh - 1 - j); ++k) {
             const int i0 = lo[size_t(j + k)], i1 = hi[size_t(j + k)];
             if (i0 >= i1) continue;
             const float wk = wy[k + ry];
-            const float* in = &tmp[size_t(j + k) * gw * n];
-            float* out = &acc[size_t(j) * gw * stride + c0];
+            const float* in = &tmp[size_t(j + k - box.y0) * tw * n];
+            float* o = &acc[size_t(j) * gw * stride + c0];
             for (int i = i0; i < i1; ++i)
-                for (int ch = 0; ch < n; ++ch) out[size_t(i) * stride + ch] += wk * in[size_t(i) * n + ch];
+                for (int ch = 0; ch < n; ++ch) o[size_t(i) * stride + ch] += wk * in[size_t(i - tx0) * n + ch];
         }
+    return out;
 }
-void smooth(std::vector<float>& acc, int gw, int gh, int stride, float sigma, float sigmaY, int c0 = 0, int c1 = -1) {
+CellBox smooth(std::vector<float>& acc, int gw, int gh, int stride, float sigma, float sigmaY, CellBox box, int c0 = 0, int c1 = -1) {
     if (c1 < 0) c1 = stride;
     switch (c1 - c0) {
-        case 1: return smoothRun<1>(acc, gw, gh, stride, sigma, sigmaY, c0, c1);
-        case 2: return smoothRun<2>(acc, gw, gh, stride, sigma, sigmaY, c0, c1);
-        case 3: return smoothRun<3>(acc, gw, gh, stride, sigma, sigmaY, c0, c1);
-        case 4: return smoothRun<4>(acc, gw, gh, stride, sigma, sigmaY, c0, c1);
-        case 6: return smoothRun<6>(acc, gw, gh, stride, sigma, sigmaY, c0, c1);
-        case 4 * kTimeBins: return smoothRun<4 * kTimeBins>(acc, gw, gh, stride, sigma, sigmaY, c0, c1);  // a moving layer's W, R, G, B per time bin
-        case 2 + 4 * kTimeBins: return smoothRun<2 + 4 * kTimeBins>(acc, gw, gh, stride, sigma, sigmaY, c0, c1);  // ... with N and the slopes
-        default: return smoothRun<0>(acc, gw, gh, stride, sigma, sigmaY, c0, c1);
+        case 1: return smoothRun<1>(acc, gw, gh, stride, sigma, sigmaY, c0, c1, box);
+        case 2: return smoothRun<2>(acc, gw, gh, stride, sigma, sigmaY, c0, c1, box);
+        case 3: return smoothRun<3>(acc, gw, gh, stride, sigma, sigmaY, c0, c1, box);
+        case 4: return smoothRun<4>(acc, gw, gh, stride, sigma, sigmaY, c0, c1, box);
+        case 6: return smoothRun<6>(acc, gw, gh, stride, sigma, sigmaY, c0, c1, box);
+        case 4 * kTimeBins: return smoothRun<4 * kTimeBins>(acc, gw, gh, stride, sigma, sigmaY, c0, c1, box);  // a moving layer's W, R, G, B per time bin
+        case 2 + 4 * kTimeBins: return smoothRun<2 + 4 * kTimeBins>(acc, gw, gh, stride, sigma, sigmaY, c0, c1, box);  // ... with N and the slopes
+        default: return smoothRun<0>(acc, gw, gh, stride, sigma, sigmaY, c0, c1, box);
     }
 }
 
@@ -1002,29 +1059,36 @@ void smooth(std::vector<float>& acc, int gw, int gh, int stride, float sigma, fl
 /// light were noisier inside its trail: AAF relMSE docs/motion.json +3%, many-motion +4%,
 /// à-trous +11% and +3%; with the plain Gaussian a lit strip's edge blurs. docs/layers.md,
 /// "Crisp across the motion".)
-void smoothAcrossEdges(std::vector<float>& acc, int gw, int gh, int stride, int c0, float sigma, int axis, float edge) {
+/// `box`: where those channels can be non-zero (CellBox); returns where they can be after (the
+/// box grown by the Gaussian's reach along the axis). Beyond that reach of the box a cell and
+/// all its neighbours are zero and add nothing: skipped, the same sums in the same order.
+CellBox smoothAcrossEdges(std::vector<float>& acc, int gw, int gh, int stride, int c0, float sigma, int axis, float edge, CellBox box) {
     const int n = stride - c0;
     const std::vector<float> taps = gaussianTaps(sigma);
     const int r = int(taps.size() / 2);
-    const size_t cells = size_t(gw) * gh;
+    if (box.empty()) return box;
+    const CellBox b = box.grown(axis == 0 ? r : 0, axis == 1 ? r : 0, gw, gh);
+    const int bw = b.x1 - b.x0, bh = b.y1 - b.y0;
+    const size_t cells = size_t(bw) * bh;  // (within b: cell q of b is the grid's (b.x0 + q % bw, b.y0 + q / bw))
+    auto gridIndex = [&](size_t q) { return (size_t(b.y0) + q / size_t(bw)) * size_t(gw) + size_t(b.x0) + q % size_t(bw); };
     std::vector<float> luminance(cells, -1.f);  // -1: no weight (the cell adds nothing)
     for (size_t q = 0; q < cells; ++q) {
-        const float* a = &acc[q * stride + c0];
+        const float* a = &acc[gridIndex(q) * stride + c0];
         float w = 0, v = 0;
-        for (int b = 0; b < n / 4; ++b) w += a[4 * b], v += a[4 * b + 1] + a[4 * b + 2] + a[4 * b + 3];
+        for (int k = 0; k < n / 4; ++k) w += a[4 * k], v += a[4 * k + 1] + a[4 * k + 2] + a[4 * k + 3];
         if (w > 0.f) luminance[q] = v / w;
     }
     std::vector<float> out(cells * n, 0.f);
-    const int len = axis == 1 ? gh : gw, step = axis == 1 ? gw : 1;
+    const int len = axis == 1 ? bh : bw, step = axis == 1 ? bw : 1, gridStep = axis == 1 ? gw : 1;
     // Each pair of cells once (its weight is symmetric), from the lower one; a cell without
     // weight adds nothing and takes the plain Gaussian of its neighbours.
     for (size_t q = 0; q < cells; ++q) {
         const bool hasQ = luminance[q] >= 0.f;
         float* oq = &out[q * n];
-        const float* iq = &acc[q * stride + c0];
+        const float* iq = &acc[gridIndex(q) * stride + c0];
         if (hasQ)
             for (int ch = 0; ch < n; ++ch) oq[ch] += iq[ch];
-        const int at = axis == 1 ? int(q / size_t(gw)) : int(q % size_t(gw));
+        const int at = axis == 1 ? int(q / size_t(bw)) : int(q % size_t(bw));
         for (int k = 1; k <= std::min(r, len - 1 - at); ++k) {
             const size_t e = q + size_t(k) * size_t(step);
             const bool hasE = luminance[e] >= 0.f;
@@ -1035,11 +1099,12 @@ void smoothAcrossEdges(std::vector<float>& acc, int gw, int gh, int stride, int 
                 w *= std::exp(-0.5f * d * d);
             }
             float* oe = &out[e * n];
-            const float* ie = &acc[e * stride + c0];
+            const float* ie = iq + size_t(k) * size_t(gridStep) * size_t(stride);
             for (int ch = 0; ch < n; ++ch) oq[ch] += w * ie[ch], oe[ch] += w * iq[ch];
         }
     }
-    for (size_t q = 0; q < cells; ++q) std::copy_n(&out[q * n], n, &acc[q * stride + c0]);
+    for (size_t q = 0; q < cells; ++q) std::copy_n(&out[q * n], n, &acc[gridIndex(q) * stride + c0]);
+    return b;
 }
 
 /// How many rings of missing cells resolveCells fills from their neighbours (alpha 0 beyond).
@@ -1050,11 +1115,18 @@ constexpr int kFillRings = 4;
 /// a cell with alpha but no radiance, or without enough weight for alpha (the layer hidden
 /// there: everything of it and behind it covered by the layers in front), takes the mean of its
 /// valid neighbours, ring by ring (a few rings; alpha 0 beyond them).
-void resolveCells(Layer& l, float minWeight) {
+/// `box`: where acc and accD can be non-zero, grown by the rings (CellBox). Every cell beyond it
+/// resolves to alpha 0, no light and the layer's slope, and no ring reaches it: only that is set.
+void resolveCells(Layer& l, float minWeight, CellBox box) {
     const int cells = l.gw * l.gh, as = l.accStride(), cs = l.cellStride(), bins = l.timeBins;
     l.cell.assign(size_t(cells) * cs, 0.f);
+    for (int i = 0; i < cells; ++i) l.cell[size_t(i) * cs + size_t(cs - 1)] = l.c;
     std::vector<uint8_t> alphaOk(cells, 0), radianceOk(cells, 0);
-    for (int i = 0; i < cells; ++i) {
+    auto forEachInBox = [&](auto&& fn) {
+        for (int y = box.y0; y < box.y1; ++y)
+            for (int i = y * l.gw + box.x0; i < y * l.gw + box.x1; ++i) fn(i);
+    };
+    forEachInBox([&](int i) {
         const float* a = &l.acc[size_t(i) * as];
         const float d = l.accD[i];
         float* c = &l.cell[size_t(i) * cs];
@@ -1071,7 +1143,7 @@ void resolveCells(Layer& l, float minWeight) {
             for (int ch = 0; ch < 3; ++ch) c[1 + 3 * b + ch] = ab[1 + ch] * inv;
             if (have < 0) have = b;
         }
-        if (have < 0) continue;
+        if (have < 0) return;
         radianceOk[i] = 1;
         // Empty time bins take the nearest bin that has samples.
         for (int b = 0; b < bins; ++b) {
@@ -1081,13 +1153,14 @@ void resolveCells(Layer& l, float minWeight) {
                 if (a[2 + 4 * k] >= minWeight && std::abs(k - b) < std::abs(best - b)) best = k;
             for (int ch = 0; ch < 3; ++ch) c[1 + 3 * b + ch] = c[1 + 3 * best + ch];
         }
-    }
+    });
     // Ring-by-ring fill of what is missing where it can matter (alpha everywhere, radiance where
     // the cell has alpha).
     auto isHole = [&](int i) { return !alphaOk[i] || (!radianceOk[i] && l.cell[size_t(i) * cs] > 0.f); };
     std::vector<int> holes;
-    for (int i = 0; i < cells; ++i)
+    forEachInBox([&](int i) {
         if (isHole(i)) holes.push_back(i);
+    });
     // Per ring, the holes that have a valid neighbour and the means they take. Most holes of a
     // layer's grid have none (far from its samples, where nothing behind them counted in D), and
     // a hole can gain one only next to a cell filled in the ring before: after the first ring
@@ -1155,11 +1228,11 @@ void resolveCells(Layer& l, float minWeight) {
         holes.swap(next);
     }
     // Premultiply; what is still without radiance is taken as uncovered.
-    for (int i = 0; i < cells; ++i) {
+    forEachInBox([&](int i) {
         float* c = &l.cell[size_t(i) * cs];
         if (!radianceOk[i]) c[0] = 0.f;
         for (int k = 1; k < cs - 1; ++k) c[k] *= c[0];
-    }
+    });
 }
 
 /// Alpha and premultiplied radiance of a sharp layer at pixel (x, y) and shutter time t (see
@@ -2293,6 +2366,7 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                     if (l.motion) continue;
                     const int gw = l.gw, gh = l.gh;
                     summedArea(gw, gh, occupiedStill, [&](int i, int j) { return l.acc[(size_t(j) * gw + i) * l.accStride] > 0.f; });
+                    layers[size_t(k)].accBox = summedBox(occupiedStill, gw, gh);
                     if (occupiedStill.back() == 0) continue;  // no samples of its own: alpha 0 whatever D is
                     const int m = dMargin(layers[size_t(k)]);
                     near.resize(size_t(gw) * gh);
@@ -2335,7 +2409,8 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                         l.sagFit.centre = {sagFit.centre.x + float(l.gx0), sagFit.centre.y + float(l.gy0)};
                         // The mean motion per cell, and where the layer turns the mean effective
                         // sagitta, the sums smoothed alike and over the same (smoothed) count.
-                        smooth(motionAcc[k], l.gw, l.gh, 3, l.sigmaX(l.sigma), l.sigmaY(l.sigma));
+                        const CellBox counted = o.everyCell ? CellBox{0, 0, l.gw, l.gh} : nonZeroBox(motionAcc[k], l.gw, l.gh, 3);  // (its N's cells)
+                        smooth(motionAcc[k], l.gw, l.gh, 3, l.sigmaX(l.sigma), l.sigmaY(l.sigma), counted);
                         const float* count = motionAcc[k].data();  // (smoothed)
                         meanVectorGrid(count, 3, count + 1, 3, l.gw, l.gh, fit, l.motionGrid);
                         float reach = 0, spread = 0;
@@ -2349,7 +2424,7 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                         l.sagGrid.clear();
                         l.maxSag = 0;
                         if (turning) {
-                            smooth(sagAcc[k], l.gw, l.gh, 2, l.sigmaX(l.sigma), l.sigmaY(l.sigma));
+                            smooth(sagAcc[k], l.gw, l.gh, 2, l.sigmaX(l.sigma), l.sigmaY(l.sigma), counted);
                             meanVectorGrid(count, 3, sagAcc[k].data(), 2, l.gw, l.gh, sagFit, l.sagGrid);
                             float most = 0;
                             for (size_t i = 0; i < l.sagGrid.size(); i += 2) most = std::max(most, sqr(l.sagGrid[i]) + sqr(l.sagGrid[i + 1]));
@@ -2388,13 +2463,10 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                         const int gw = l.gw, gh = l.gh, as = l.accStride();
                         std::vector<int>& o = occupied[size_t(k)];
                         summedArea(gw, gh, o, [&](int i, int j) { return l.acc[(size_t(j) * gw + i) * as] > 0.f; });
-                        // The box of those cells, from the sums' last row (per column) and last column (per row).
-                        const int* lastRow = &o[size_t(gh) * (gw + 1)];
-                        int bx0 = gw, by0 = gh, bx1 = -1, by1 = -1;
-                        for (int i = 0; i < gw; ++i)
-                            if (lastRow[i + 1] > lastRow[i]) bx0 = std::min(bx0, i), bx1 = i;
-                        for (int j = 0; j < gh; ++j)
-                            if (o[size_t(j + 1) * (gw + 1) + gw] > o[size_t(j) * (gw + 1) + gw]) by0 = std::min(by0, j), by1 = j;
+                        // The box of those cells.
+                        const CellBox cellsBox = summedBox(o, gw, gh);
+                        layers[size_t(k)].accBox = cellsBox;
+                        const int bx0 = cellsBox.x0, by0 = cellsBox.y0, bx1 = cellsBox.x1 - 1, by1 = cellsBox.y1 - 1;
                         const int m = dMargin(l);
                         margin[size_t(k)] = m;
                         // (motionCells' r is at most |dt| maxMotion + 1, |dt| at most chordReach; a cell to spare.)
@@ -2456,22 +2528,28 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                     }
                 }
                 for (Layer& l : layers) {
+                    // Each pass within the cells it can change (CellBox): the same sums.
+                    const CellBox grid{0, 0, l.gw, l.gh};
+                    CellBox box = o.everyCell ? grid : l.accBox, boxD = o.everyCell ? grid : nonZeroBox(l.accD, l.gw, l.gh);
                     if (!l.sharp) {
                         const float sc = l.sigmaCoverage, sr = l.sigma;
+                        CellBox radiance;  // (of W, R, G, B)
                         if (sc == sr) {
-                            smooth(l.acc, l.gw, l.gh, l.accStride(), l.sigmaX(sr), l.sigmaY(sr));
+                            radiance = smooth(l.acc, l.gw, l.gh, l.accStride(), l.sigmaX(sr), l.sigmaY(sr), box);
                         } else {
-                            smooth(l.acc, l.gw, l.gh, l.accStride(), l.sigmaX(sc), l.sigmaY(sc), 0, 2);  // N, the slopes
-                            smooth(l.acc, l.gw, l.gh, l.accStride(), l.sigmaX(sr), l.sigmaY(sr), 2);     // W, R, G, B
+                            const CellBox coverage = smooth(l.acc, l.gw, l.gh, l.accStride(), l.sigmaX(sc), l.sigmaY(sc), box, 0, 2);  // N, the slopes
+                            radiance = smooth(l.acc, l.gw, l.gh, l.accStride(), l.sigmaX(sr), l.sigmaY(sr), box, 2);                   // W, R, G, B
+                            box = coverage;
                         }
-                        smooth(l.accD, l.gw, l.gh, 1, l.sigmaX(sc), l.sigmaY(sc));
+                        boxD = smooth(l.accD, l.gw, l.gh, 1, l.sigmaX(sc), l.sigmaY(sc), boxD);
                         // The radiance, edge-stopped along both axes (across a crisp layer's motion
                         // its only Gaussian; LayerOptions::movingEdgeWidth, stillEdgeWidth).
                         if (const float width = l.moving ? o.movingEdgeWidth : o.stillEdgeWidth; width > 0.f)
                             for (int axis = 0; axis < 2; ++axis)
-                                smoothAcrossEdges(l.acc, l.gw, l.gh, l.accStride(), 2, width * sr, axis, o.edgeStop);
+                                radiance = smoothAcrossEdges(l.acc, l.gw, l.gh, l.accStride(), 2, width * sr, axis, o.edgeStop, radiance);
+                        box = box.united(radiance);
                     }
-                    resolveCells(l, l.sharp ? 0.5f : 0.05f);
+                    resolveCells(l, l.sharp ? 0.5f : 0.05f, box.united(boxD).grown(kFillRings, kFillRings, l.gw, l.gh));
                     l.acc = std::vector<float>();
                     l.accD = std::vector<float>();
                     l.buildCovered();

@@ -138,6 +138,10 @@ struct LayerOptions {
     // those Ds; for the test that the skip changes no image, layers_test
     // Layers.TheDsSkippedFarFromALayersOwnSamplesChangeNoImage).
     bool countEveryD = false;
+    // Smooth and resolve every cell of each layer's grids, also beyond the cells its
+    // accumulations can reach (the stage works within those, CellBox in layers.cpp; for the test
+    // that this changes no image, layers_test Layers.TheCellsBeyondALayersAccumulationsChangeNoImage).
+    bool everyCell = false;
     // A blurred moving layer whose samples move along one axis of the grid, in focus (slopes
     // within 0.75 px), keeps the other axis crisp: the rays' lookup there the nearest cell, the
     // pixel's own row (column) of samples, no Gaussian across the motion for the coverage, the
