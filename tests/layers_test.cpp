@@ -263,8 +263,10 @@ TEST(Layers, TheCellsBeyondALayersAccumulationsChangeNoImage) {
     // samples on arcs: a sagitta grid), a disc in focus and a far wall (-4 px), each sample of
     // its own random radiance. The stage smooths and resolves each layer's grids only within the
     // cells its accumulations can reach (CellBox), and the image must be the one that works on
-    // every cell, to the bit. (It fails with the motion grid's sums smoothed over an empty box,
-    // as before the box of its counts was known, or with a Gaussian's box not grown along y.)
+    // every cell, to the bit; so must the rays that skip the layers they cannot read along each
+    // axis apart (Layer::rayExtent). (It fails with the motion grid's sums smoothed over an empty
+    // box, as before the box of its counts was known, with a Gaussian's box not grown along y, or
+    // with the rays' extents without the motion.)
     const int W = 192, H = 128;
     const ViewGeometry view = wideLensView(W, H);
     LightFieldSamples lf(W, H, true);

@@ -435,6 +435,11 @@ struct Layer {
     /// How far (pixels) a ray's lookups can land from the pixel: the largest slope (the rays
     /// follow the slope they find, never beyond the layer's extremes) and half the motion.
     float rayReach = 0;
+    /// ... along each axis apart (a layer moving sideways reaches a pixel's rays from far along
+    /// x, from as far as its blur along y): the slope, and each axis's largest motion and sagitta
+    /// (motionExtent, sagExtent).
+    Vec2f rayExtent{};
+    Vec2f motionExtent{}, sagExtent{};  // the largest |x| and |y| over motionGrid, sagGrid
     int accStride() const { return 2 + 4 * timeBins; }
     int cellStride() const { return 2 + 3 * timeBins; }  // ... and last the samples' mean slope there
 
@@ -450,12 +455,13 @@ struct Layer {
     }
     /// Whether any covered cell can be read by a lookup of pixel (x, y)'s rays: bilinear lookups
     /// within rayReach of the pixel's square, a sharp layer's at the pixel's own cell.
-    bool reaches(int x, int y) const {
-        const float r = sharp ? 0.f : rayReach;
-        const int i0 = std::max(0, int(std::floor(float(x - gx0) - r)) - 1);
-        const int i1 = std::min(gw - 1, int(std::ceil(float(x + 1 - gx0) + r)) + 1);
-        const int j0 = std::max(0, int(std::floor(float(y - gy0) - r)) - 1);
-        const int j1 = std::min(gh - 1, int(std::ceil(float(y + 1 - gy0) + r)) + 1);
+    bool reaches(int x, int y) const { return sharp ? reaches(x, y, Vec2f{}) : reaches(x, y, Vec2f{rayReach, rayReach}); }
+    /// ... within r.x of the pixel's square along x and r.y along y.
+    bool reaches(int x, int y, Vec2f r) const {
+        const int i0 = std::max(0, int(std::floor(float(x - gx0) - r.x)) - 1);
+        const int i1 = std::min(gw - 1, int(std::ceil(float(x + 1 - gx0) + r.x)) + 1);
+        const int j0 = std::max(0, int(std::floor(float(y - gy0) - r.y)) - 1);
+        const int j1 = std::min(gh - 1, int(std::ceil(float(y + 1 - gy0) + r.y)) + 1);
         if (i0 > i1 || j0 > j1) return false;
         const size_t s = size_t(gw + 1);
         return covered[(j1 + 1) * s + i1 + 1] - covered[j0 * s + i1 + 1] - covered[(j1 + 1) * s + i0] + covered[j0 * s + i0] > 0;
@@ -2414,20 +2420,26 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                         const float* count = motionAcc[k].data();  // (smoothed)
                         meanVectorGrid(count, 3, count + 1, 3, l.gw, l.gh, fit, l.motionGrid);
                         float reach = 0, spread = 0;
+                        l.motionExtent = {};
                         for (size_t i = 0; i < l.motionGrid.size(); i += 2) {
                             const float mx = l.motionGrid[i], my = l.motionGrid[i + 1];
                             reach = std::max(reach, mx * mx + my * my);
                             spread = std::max(spread, sqr(mx - fit.mean.x) + sqr(my - fit.mean.y));
+                            l.motionExtent = vmax(l.motionExtent, Vec2f{std::abs(mx), std::abs(my)});
                         }
                         l.maxMotion = std::sqrt(reach);
                         l.motionSpread = std::sqrt(spread);
                         l.sagGrid.clear();
                         l.maxSag = 0;
+                        l.sagExtent = {};
                         if (turning) {
                             smooth(sagAcc[k], l.gw, l.gh, 2, l.sigmaX(l.sigma), l.sigmaY(l.sigma), counted);
                             meanVectorGrid(count, 3, sagAcc[k].data(), 2, l.gw, l.gh, sagFit, l.sagGrid);
                             float most = 0;
-                            for (size_t i = 0; i < l.sagGrid.size(); i += 2) most = std::max(most, sqr(l.sagGrid[i]) + sqr(l.sagGrid[i + 1]));
+                            for (size_t i = 0; i < l.sagGrid.size(); i += 2) {
+                                most = std::max(most, sqr(l.sagGrid[i]) + sqr(l.sagGrid[i + 1]));
+                                l.sagExtent = vmax(l.sagExtent, Vec2f{std::abs(l.sagGrid[i]), std::abs(l.sagGrid[i + 1])});
+                            }
                             l.maxSag = std::sqrt(most);
                         }
                     }
@@ -2553,9 +2565,11 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                     l.acc = std::vector<float>();
                     l.accD = std::vector<float>();
                     l.buildCovered();
-                    l.rayReach = std::max({std::abs(l.cMin), std::abs(l.cMax), std::abs(l.rayC), std::abs(l.rayC + l.rayC2)}) +
-                                 chordReach(l.depthRate) * std::max(std::sqrt(l.rayMx * l.rayMx + l.rayMy * l.rayMy), l.motionScale * l.maxMotion) +
-                                 l.maxSag;
+                    const float slopeReach = std::max({std::abs(l.cMin), std::abs(l.cMax), std::abs(l.rayC), std::abs(l.rayC + l.rayC2)});
+                    const float chord = chordReach(l.depthRate);
+                    l.rayReach = slopeReach + chord * std::max(std::sqrt(l.rayMx * l.rayMx + l.rayMy * l.rayMy), l.motionScale * l.maxMotion) + l.maxSag;
+                    l.rayExtent = {slopeReach + chord * std::max(std::abs(l.rayMx), l.motionScale * l.motionExtent.x) + l.sagExtent.x,
+                                   slopeReach + chord * std::max(std::abs(l.rayMy), l.motionScale * l.motionExtent.y) + l.sagExtent.y};
                 }
                 // A layer a pixel's rays can see; a sharp still layer is the same for every ray
                 // (its pixel's cell), looked up once.
@@ -2563,6 +2577,10 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                     const Layer* layer;
                     bool fixed;
                     Lookup value;
+                    // No ray of the pixel can read a covered cell of it along both axes apart
+                    // (Layer::rayExtent): the rays skip it, which changes nothing they find. (It
+                    // stays in the pixel's list, whose layers decide how many rays it takes.)
+                    bool skip;
                 };
                 std::vector<Active> active;
                 std::vector<int> binActive;  // (timeOrder) per order bin, `active` in its order
@@ -2610,7 +2628,7 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                         for (const Layer& l : layers) {
                             if (!l.reaches(x, y)) continue;
                             const bool fixed = l.sharp && l.timeBins == 1;
-                            active.push_back({&l, fixed, fixed ? lookupSharp(l, x, y, 0.5f) : Lookup{}});
+                            active.push_back({&l, fixed, fixed ? lookupSharp(l, x, y, 0.5f) : Lookup{}, !o.everyCell && !l.sharp && !l.reaches(x, y, l.rayExtent)});
                         }
                         // (timeOrder) The order of those layers in each order bin, and whether it
                         // is one for every bin.
@@ -2668,6 +2686,7 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                                 bool live = false;
                                 for (int j = j0; j < j1; ++j) live |= ray.trans[j] >= 1e-4f;
                                 if (!live) break;
+                                if (a.skip) continue;
                                 const Layer& l = *a.layer;
                                 const int index = int(&a - active.data());
                                 auto take = [&](int j, const Lookup& v) {

@@ -139,8 +139,10 @@ struct LayerOptions {
     // Layers.TheDsSkippedFarFromALayersOwnSamplesChangeNoImage).
     bool countEveryD = false;
     // Smooth and resolve every cell of each layer's grids, also beyond the cells its
-    // accumulations can reach (the stage works within those, CellBox in layers.cpp; for the test
-    // that this changes no image, layers_test Layers.TheCellsBeyondALayersAccumulationsChangeNoImage).
+    // accumulations can reach (the stage works within those, CellBox in layers.cpp), and trace a
+    // pixel's rays through every layer within its reach as one radius (the stage skips those
+    // its rays cannot read along each axis apart, Layer::rayExtent). For the test that neither
+    // changes an image, layers_test Layers.TheCellsBeyondALayersAccumulationsChangeNoImage.
     bool everyCell = false;
     // A blurred moving layer whose samples move along one axis of the grid, in focus (slopes
     // within 0.75 px), keeps the other axis crisp: the rays' lookup there the nearest cell, the
