@@ -1260,10 +1260,11 @@ struct Bilinear {
 [[gnu::always_inline]] inline int minValue(int a, int b) { return b < a ? b : a; }
 [[gnu::always_inline]] inline int maxValue(int a, int b) { return a < b ? b : a; }
 [[gnu::always_inline]] inline Bilinear bilinear(const Layer& l, Vec2f p) {
-    const float fx = l.crisp == 0 ? clampValue(std::floor(p.x - float(l.gx0)), 0.f, float(l.gw - 1))
-                                  : clampValue(p.x - float(l.gx0) - 0.5f, 0.f, float(l.gw - 1));
-    const float fy = l.crisp == 1 ? clampValue(std::floor(p.y - float(l.gy0)), 0.f, float(l.gh - 1))
-                                  : clampValue(p.y - float(l.gy0) - 0.5f, 0.f, float(l.gh - 1));
+    // (Both roundings computed and one selected: a floor under the condition is a masked call,
+    // which kept traceBlurred's loops from vectorising.)
+    const float x = p.x - float(l.gx0), y = p.y - float(l.gy0), floorX = std::floor(x), floorY = std::floor(y);
+    const float fx = clampValue(l.crisp == 0 ? floorX : x - 0.5f, 0.f, float(l.gw - 1));
+    const float fy = clampValue(l.crisp == 1 ? floorY : y - 0.5f, 0.f, float(l.gh - 1));
     const int i0 = minValue(int(fx), std::max(0, l.gw - 2)), j0 = minValue(int(fy), std::max(0, l.gh - 2));
     const float ax = fx - float(i0), ay = fy - float(j0);
     // A blurred layer's grid is at least 7 cells a side (its tile and a margin of at least
@@ -1434,11 +1435,19 @@ struct Rays {
 /// same order, as one SIMD loop (its images the same to float rounding, docs/layers.md): every
 /// lane is computed, and a stopped ray's results are not stored. Returns whether a ray took
 /// part of the layer's coverage.
-template <bool kFollow, bool kMoving, bool kCurved = false>
-bool traceBlurred(const Layer& l, int index, Rays& ray, int j0, int j1) {
+/// (kGrid: the layer has a motion grid, followed as above; a template parameter, since a
+/// runtime condition in the loop left its lookups masked, and GCC kept such loops scalar.)
+template <bool kFollow, bool kMoving, bool kGrid, bool kCurved>
+bool traceBlurredRays(const Layer& l, int index, Rays& ray, int j0, int j1) {
     const int cs = l.cellStride(), bins = l.timeBins;
     const float* cell = l.cell.data();
-    const bool followMotion = kMoving && !l.motionGrid.empty();
+    constexpr bool followMotion = kMoving && kGrid;
+    // (The grids' and the shear table's bases in locals: gathers through the layer were not
+    // supported, and kept the loop scalar.)
+    const float* motionGrid = l.motionGrid.data();
+    const float* sagGrid = l.sagGrid.data();
+    float shearA[Layer::kShearSteps + 1], shearB[Layer::kShearSteps + 1];
+    for (int i = 0; i <= Layer::kShearSteps; ++i) shearA[i] = l.shearTable[i].a, shearB[i] = l.shearTable[i].b;
     const AffineMotion fit = l.motionFit, sagFit = l.sagFit;
     int partial = 0;
 #pragma omp simd reduction(| : partial)
@@ -1450,17 +1459,15 @@ bool traceBlurred(const Layer& l, int index, Rays& ray, int j0, int j1) {
         const float tau = l.motionScale * shaped, arcK = 4.f * tau * tau;
         float mox = l.rayMx * st, moy = l.rayMy * st;
         float cRay = l.rayC + l.rayC2 * ray.u2[j];
-        if (followMotion) {
-            Vec2f shift;
-            if constexpr (kCurved) {
-                shift = curvedMotionShift(fit, sagFit, ray.px[j] + cRay * ray.ux[j], ray.py[j] - cRay * ray.uy[j], l.motionScale * st, arcK,
-                                          {mox, moy});
-            } else {
-                shift = motionShift(fit, ray.px[j] + cRay * ray.ux[j], ray.py[j] - cRay * ray.uy[j], l.motionScale * st, {mox, moy});
-            }
+        if constexpr (followMotion) {
+            // (One expression: a Vec2f declared here and assigned in the branches became a
+            // per-lane array with masked stores, and the moving variants' loops did not vectorise.)
+            const float qx = ray.px[j] + cRay * ray.ux[j], qy = ray.py[j] - cRay * ray.uy[j];
+            const Vec2f shift = kCurved ? curvedMotionShift(fit, sagFit, qx, qy, l.motionScale * st, arcK, {mox, moy})
+                                        : motionShift(fit, qx, qy, l.motionScale * st, {mox, moy});
             mox = shift.x, moy = shift.y;
         }
-        if (kFollow || followMotion) {
+        if constexpr (kFollow || followMotion) {
             // One fixed-point step: the slope and the motion of the surface found at the
             // layer's shear.
             const Bilinear b = bilinear(l, {ray.px[j] + cRay * ray.ux[j] - mox, ray.py[j] - cRay * ray.uy[j] - moy});
@@ -1468,12 +1475,16 @@ bool traceBlurred(const Layer& l, int index, Rays& ray, int j0, int j1) {
                 float slope = 0;
 #pragma GCC unroll 4
                 for (int k = 0; k < 4; ++k) slope += b.w[k] * cell[b.cell[k] * cs + cs - 1];
-                const Shaped sh = lerp(l.shearTable, clampValue((slope - l.shearFrom) * l.shearScale, 0.f, float(Layer::kShearSteps) - 1e-3f));
-                cRay = sh.a + sh.b * ray.u2[j];
+                // (lerp() over the table's copy.)
+                const float at = clampValue((slope - l.shearFrom) * l.shearScale, 0.f, float(Layer::kShearSteps) - 1e-3f);
+                const int i = int(at);
+                const float f = at - float(i);
+                const float a = shearA[i] + f * (shearA[i + 1] - shearA[i]), bb = shearB[i] + f * (shearB[i + 1] - shearB[i]);
+                cRay = a + bb * ray.u2[j];
             }
             if constexpr (kMoving) {
-                if (followMotion) {
-                    const Vec2f m = motionAt(l, b);
+                if constexpr (followMotion) {
+                    const Vec2f m = vectorAt(motionGrid, b);
                     mox = l.motionScale * m.x * st;
                     moy = l.motionScale * m.y * st;
                     if constexpr (kCurved) {
@@ -1482,11 +1493,11 @@ bool traceBlurred(const Layer& l, int index, Rays& ray, int j0, int j1) {
                         // sagitta where the first put it (the sagitta moves the lookup by up to
                         // its length).
                         const float k = arcK;
-                        const Vec2f e = sagAt(l, b);
+                        const Vec2f e = vectorAt(sagGrid, b);
                         mox -= k * e.x;
                         moy -= k * e.y;
                         const Bilinear b2 = bilinear(l, {ray.px[j] + cRay * ray.ux[j] - mox, ray.py[j] - cRay * ray.uy[j] - moy});
-                        const Vec2f m2 = motionAt(l, b2), e2 = sagAt(l, b2);
+                        const Vec2f m2 = vectorAt(motionGrid, b2), e2 = vectorAt(sagGrid, b2);
                         mox = l.motionScale * m2.x * st - k * e2.x;
                         moy = l.motionScale * m2.y * st - k * e2.y;
                     }
@@ -1505,11 +1516,14 @@ bool traceBlurred(const Layer& l, int index, Rays& ray, int j0, int j1) {
             alpha += w * cell[c];
             const int c0 = c + 1 + 3 * b0;
             if constexpr (kMoving) {
+                // (Both bins' light read whatever `one` is: loads under the condition were masked
+                // gathers, and kept the loop scalar.)
                 const int c1 = c + 1 + 3 * b1;
                 const bool one = b1 == b0;
-                r = one ? r + cell[c0] * w : r + (cell[c0] * (w * (1.f - at)) + cell[c1] * (w * at));
-                g = one ? g + cell[c0 + 1] * w : g + (cell[c0 + 1] * (w * (1.f - at)) + cell[c1 + 1] * (w * at));
-                bl = one ? bl + cell[c0 + 2] * w : bl + (cell[c0 + 2] * (w * (1.f - at)) + cell[c1 + 2] * (w * at));
+                const float r0 = cell[c0], g0 = cell[c0 + 1], bl0 = cell[c0 + 2], r1 = cell[c1], g1 = cell[c1 + 1], bl1 = cell[c1 + 2];
+                r = one ? r + r0 * w : r + (r0 * (w * (1.f - at)) + r1 * (w * at));
+                g = one ? g + g0 * w : g + (g0 * (w * (1.f - at)) + g1 * (w * at));
+                bl = one ? bl + bl0 * w : bl + (bl0 * (w * (1.f - at)) + bl1 * (w * at));
             } else {
                 r += cell[c0] * w;
                 g += cell[c0 + 1] * w;
@@ -1519,6 +1533,13 @@ bool traceBlurred(const Layer& l, int index, Rays& ray, int j0, int j1) {
         partial |= composite(ray, j, index, alpha, r, g, bl);
     }
     return partial != 0;
+}
+template <bool kFollow, bool kMoving, bool kCurved = false>
+bool traceBlurred(const Layer& l, int index, Rays& ray, int j0, int j1) {
+    if constexpr (kMoving) {
+        if (!l.motionGrid.empty()) return traceBlurredRays<kFollow, true, true, kCurved>(l, index, ray, j0, j1);
+    }
+    return traceBlurredRays<kFollow, kMoving, false, false>(l, index, ray, j0, j1);
 }
 
 /// Samples behind a layer with a motion grid, for its D (the D pass of reconstructLayers): each
