@@ -213,6 +213,22 @@ TEST(Layers, AConstantLightFieldStaysConstantAndEmptyTilesGiveNoNaN) {
         }
 }
 
+/// The light field reconstructed with `options` and with `reference` (an exhaustive variant of
+/// the same work): several layers a tile, most tiles blurred, and the same image to the bit.
+static void expectTheSameBits(const LightFieldSamples& lf, const ViewGeometry& view, const filter::LayerOptions& options,
+                              const filter::LayerOptions& reference) {
+    filter::LayerStats stats;
+    const Image3f a = filter::reconstructLayers(filter::LayerInput{lf, view, {}}, options, &stats);
+    const Image3f b = filter::reconstructLayers(filter::LayerInput{lf, view, {}}, reference, nullptr);
+    EXPECT_GT(stats.layersPerTile, 2.0);
+    EXPECT_GT(stats.blurredTiles, 0.5);
+    for (int y = 0; y < a.height(); ++y)
+        for (int x = 0; x < a.width(); ++x) {
+            ASSERT_TRUE(isFinite(a(x, y))) << x << ", " << y;
+            ASSERT_EQ(std::memcmp(&a(x, y), &b(x, y), sizeof(Vec3f)), 0) << x << ", " << y;
+        }
+}
+
 TEST(Layers, TheDsSkippedFarFromALayersOwnSamplesChangeNoImage) {
     // A disc in focus, a defocused post in front (slope +5 px), a box moving 30 px over the
     // shutter just in front of the focus (its layer has a motion grid) and a far wall (-4 px),
@@ -243,18 +259,9 @@ TEST(Layers, TheDsSkippedFarFromALayersOwnSamplesChangeNoImage) {
                                                 post ? 1 : 0);
             }
         }
-    filter::LayerStats stats;
-    filter::LayerOptions skipping, counting;
+    filter::LayerOptions counting;
     counting.countEveryD = true;
-    const Image3f a = filter::reconstructLayers(filter::LayerInput{lf, view, {}}, skipping, &stats);
-    const Image3f b = filter::reconstructLayers(filter::LayerInput{lf, view, {}}, counting, nullptr);
-    EXPECT_GT(stats.layersPerTile, 2.0);
-    EXPECT_GT(stats.blurredTiles, 0.5);
-    for (int y = 0; y < H; ++y)
-        for (int x = 0; x < W; ++x) {
-            ASSERT_TRUE(isFinite(a(x, y))) << x << ", " << y;
-            ASSERT_EQ(std::memcmp(&a(x, y), &b(x, y), sizeof(Vec3f)), 0) << x << ", " << y;
-        }
+    expectTheSameBits(lf, view, filter::LayerOptions{}, counting);
 }
 
 TEST(Layers, TheCellsBeyondALayersAccumulationsChangeNoImage) {
@@ -293,18 +300,9 @@ TEST(Layers, TheCellsBeyondALayersAccumulationsChangeNoImage) {
                 sags[k] = LightFieldSag::pack(turning ? Vec2f{0.f, 4.f} : Vec2f{0.f, 0.f});
             }
         }
-    filter::LayerStats stats;
-    filter::LayerOptions boxed, everyCell;
+    filter::LayerOptions everyCell;
     everyCell.everyCell = true;
-    const Image3f a = filter::reconstructLayers(filter::LayerInput{lf, view, {}}, boxed, &stats);
-    const Image3f b = filter::reconstructLayers(filter::LayerInput{lf, view, {}}, everyCell, nullptr);
-    EXPECT_GT(stats.layersPerTile, 2.0);
-    EXPECT_GT(stats.blurredTiles, 0.5);
-    for (int y = 0; y < H; ++y)
-        for (int x = 0; x < W; ++x) {
-            ASSERT_TRUE(isFinite(a(x, y))) << x << ", " << y;
-            ASSERT_EQ(std::memcmp(&a(x, y), &b(x, y), sizeof(Vec3f)), 0) << x << ", " << y;
-        }
+    expectTheSameBits(lf, view, filter::LayerOptions{}, everyCell);
 }
 
 TEST(Layers, WhereAFilteredLightIsAnotherPointsASampleCarriesItsOwn) {
