@@ -114,14 +114,8 @@ constexpr double kKronecker[5] = {0.8812714616335696, 0.7766393890897683, 0.6844
 struct Shaped {
     float a = 0, b = 0;
 };
-/// Linear in a table of Shaped at fractional index `at` (0 <= at < its last index).
-[[gnu::always_inline]] inline Shaped lerp(const Shaped* table, float at) {
-    const int i = int(at);
-    const float f = at - float(i);
-    return {table[i].a + f * (table[i + 1].a - table[i].a), table[i].b + f * (table[i + 1].b - table[i].b)};
-}
-/// (a, b) at rho from a table at rho = 0, step, ...; none from `limit`. (Its interpolation is
-/// lerp()'s written out: through lerp() GCC contracted it differently, a few image bytes.)
+/// (a, b) at rho from a table at rho = 0, step, ...; none from `limit`, linear between entries.
+/// (traceBlurredRays interpolates a layer's table of these likewise, written out there.)
 template <int N>
 Shaped shaped(float rho, const Shaped (&table)[N], float step, float limit) {
     if (!(rho < limit)) return {};
@@ -1475,7 +1469,8 @@ bool traceBlurredRays(const Layer& l, int index, Rays& ray, int j0, int j1) {
                 float slope = 0;
 #pragma GCC unroll 4
                 for (int k = 0; k < 4; ++k) slope += b.w[k] * cell[b.cell[k] * cs + cs - 1];
-                // (lerp() over the table's copy.)
+                // (Linear in the table's copy, written out: a Shaped returned by a helper kept the
+                // loop scalar.)
                 const float at = clampValue((slope - l.shearFrom) * l.shearScale, 0.f, float(Layer::kShearSteps) - 1e-3f);
                 const int i = int(at);
                 const float f = at - float(i);
