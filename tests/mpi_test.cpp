@@ -112,6 +112,21 @@ TEST(Mpi, MaafIsBitIdenticalToOneProcess) {
     expectSameAsOneProcess("render cornell --method maaf --spp 4 --maaf-keep-records --resolution 64x48 --quiet");
 }
 
+/// A 64x48 scene file of `objects` (JSON, white) before a white wall, under one parallelogram
+/// light, 4 spp and seed 5; its path.
+std::string barScene(const std::string& objects) {
+    const std::string path = tempDir() + "/bar.json";
+    writeFile(path, R"({
+      "camera": {"position": [0, 0, 0], "look_at": [0, 0, -1], "up": [0, 1, 0], "fov_y": 20, "resolution": [64, 48]},
+      "materials": {"white": {"albedo": [0.8, 0.8, 0.8]}},
+      "lights": [{"type": "parallelogram", "corner": [-1, 2, -3], "edge1": [0, 0, -2], "edge2": [2, 0, 0], "radiance": [5, 5, 5]}],
+      "objects": [)" + objects + R"(,
+                  {"type": "quad", "corner": [-3, -3, -6], "edge1": [6, 0, 0], "edge2": [0, 6, 0], "material": "white"}],
+      "render": {"spp": 4, "seed": 5, "indirect": true}
+    })");
+    return path;
+}
+
 TEST(Mpi, AafAroundATurningBarIsBitIdenticalToOneProcess) {
     REQUIRE_MPI();
     // A bar turning 120 degrees about (0, 1, 1) before a wall, and a moving post across the edge
@@ -120,35 +135,19 @@ TEST(Mpi, AafAroundATurningBarIsBitIdenticalToOneProcess) {
     // the pixels of its rows, and the marks are exchanged before the mask is made (without the
     // exchange the images differ at -n 2 and -n 3: the rows are dealt in turn, so a rank's marks
     // alone reach nearly, not exactly, as far).
-    const std::string dir = tempDir();
-    writeFile(dir + "/turn.json", R"({
-      "camera": {"position": [0, 0, 0], "look_at": [0, 0, -1], "up": [0, 1, 0], "fov_y": 20, "resolution": [64, 48]},
-      "materials": {"white": {"albedo": [0.8, 0.8, 0.8]}},
-      "lights": [{"type": "parallelogram", "corner": [-1, 2, -3], "edge1": [0, 0, -2], "edge2": [2, 0, 0], "radiance": [5, 5, 5]}],
-      "objects": [{"type": "quad", "corner": [-0.45, -0.45, -4], "edge1": [0.5, 0, 0], "edge2": [0, 0.08, 0], "material": "white",
-                   "angular_velocity": [0, 1, 1, 120]},
-                  {"type": "box", "min": [0.2, -0.6, -3.5], "max": [0.3, 0.3, -3.4], "material": "white", "velocity": [0.1, 0, 0]},
-                  {"type": "quad", "corner": [-3, -3, -6], "edge1": [6, 0, 0], "edge2": [0, 6, 0], "material": "white"}],
-      "render": {"spp": 4, "seed": 5, "indirect": true}
-    })");
-    expectSameAsOneProcess("render " + dir + "/turn.json --method aaf --spp 4 --quiet");
+    const std::string scene = barScene(R"({"type": "quad", "corner": [-0.45, -0.45, -4], "edge1": [0.5, 0, 0], "edge2": [0, 0.08, 0], "material": "white",
+                                           "angular_velocity": [0, 1, 1, 120]},
+                                          {"type": "box", "min": [0.2, -0.6, -3.5], "max": [0.3, 0.3, -3.4], "material": "white", "velocity": [0.1, 0, 0]})");
+    expectSameAsOneProcess("render " + scene + " --method aaf --spp 4 --quiet");
 }
 
 TEST(Mpi, McAroundASpinningBarIsBitIdenticalToOneProcess) {
     REQUIRE_MPI();
     // A bar spinning 90 degrees in the image plane before a wall: its samples keep their paths'
     // sagittas beside them (LightFieldSag), which the ranks exchange with the samples.
-    const std::string dir = tempDir();
-    writeFile(dir + "/spin.json", R"({
-      "camera": {"position": [0, 0, 0], "look_at": [0, 0, -1], "up": [0, 1, 0], "fov_y": 20, "resolution": [64, 48]},
-      "materials": {"white": {"albedo": [0.8, 0.8, 0.8]}},
-      "lights": [{"type": "parallelogram", "corner": [-1, 2, -3], "edge1": [0, 0, -2], "edge2": [2, 0, 0], "radiance": [5, 5, 5]}],
-      "objects": [{"type": "quad", "corner": [-0.45, -0.04, -4], "edge1": [0.9, 0, 0], "edge2": [0, 0.08, 0], "material": "white",
-                   "angular_velocity": [0, 0, 1, 90]},
-                  {"type": "quad", "corner": [-3, -3, -6], "edge1": [6, 0, 0], "edge2": [0, 6, 0], "material": "white"}],
-      "render": {"spp": 4, "seed": 5, "indirect": true}
-    })");
-    expectSameAsOneProcess("render " + dir + "/spin.json --method mc --spp 4 --quiet");
+    const std::string scene = barScene(R"({"type": "quad", "corner": [-0.45, -0.04, -4], "edge1": [0.9, 0, 0], "edge2": [0, 0.08, 0], "material": "white",
+                                           "angular_velocity": [0, 0, 1, 90]})");
+    expectSameAsOneProcess("render " + scene + " --method mc --spp 4 --quiet");
 }
 
 TEST(Mpi, AtrousIsBitIdenticalToOneProcess) {
