@@ -1,5 +1,7 @@
 #include "render/camera.h"
 
+#include <type_traits>
+
 namespace wedge::render {
 
 Camera::Camera(const scene::CameraDesc& d)
@@ -22,6 +24,56 @@ Camera::Pose Camera::turned(const Vec3f& position, const Vec3f& lookAt) const {
     p.right = normalize(cross(p.forward, m_sceneUp));
     p.up = cross(p.right, p.forward);
     return p;
+}
+
+namespace {
+
+/// normalize() as selects, which the vectoriser takes (its branch between two Vec3f it does not).
+inline Vec3f normalizeSelect(const Vec3f& v) {
+    const float l = length(v);
+    const bool ok = l > 0;
+    return {ok ? v.x / l : 0.f, ok ? v.y / l : 0.f, ok ? v.z / l : 0.f};
+}
+
+}  // namespace
+
+void Camera::generate(int n, const float* px, const float* py, const Vec2f* lens, const float* time, Vec3f* origin,
+                      Vec3f* direction) const {
+    if (m_turning) {
+        for (int k = 0; k < n; ++k) {
+            const Ray ray = generate(px[k], py[k], lens[k], time[k]);
+            origin[k] = ray.origin;
+            direction[k] = ray.direction;
+        }
+        return;
+    }
+    // generate()'s arithmetic, in its order, on the pose of a camera that at most translates.
+    const Vec3f p0 = m_pose.position, d = m_displacement, f = m_pose.forward, r = m_pose.right, u = m_pose.up;
+    const float w = float(m_width), h = float(m_height), tx = m_tanHalfX, ty = m_tanHalfY;
+    const float aperture = m_aperture, focusDistance = m_focus;
+    auto rays = [&](auto moving, auto lensed) {
+        for (int k = 0; k < n; ++k) {
+            const float xc = (2.f * px[k] / w - 1.f) * tx;
+            const float yc = (1.f - 2.f * py[k] / h) * ty;
+            const Vec3f position = moving ? p0 + d * time[k] : p0;
+            const Vec3f dirPinhole = f + r * xc + u * yc;
+            Vec3f o = position, dir;
+            if constexpr (!decltype(lensed)::value) {
+                dir = normalizeSelect(dirPinhole);
+            } else {
+                const Vec3f focus = position + dirPinhole * focusDistance;
+                o = position + (r * lens[k].x + u * lens[k].y) * aperture;
+                dir = normalizeSelect(focus - o);
+            }
+            // Member by member: a Vec3f's copy is one statement the vectoriser does not split.
+            origin[k].x = o.x, origin[k].y = o.y, origin[k].z = o.z;
+            direction[k].x = dir.x, direction[k].y = dir.y, direction[k].z = dir.z;
+        }
+    };
+    using Yes = std::true_type;
+    using No = std::false_type;
+    if (m_moving) aperture > 0 ? rays(Yes{}, Yes{}) : rays(Yes{}, No{});
+    else aperture > 0 ? rays(No{}, Yes{}) : rays(No{}, No{});
 }
 
 Vec2f Camera::project(const Vec3f& p, float time) const {

@@ -41,6 +41,13 @@ public:
         return {origin, normalize(focus - origin)};
     }
 
+    /// generate() for n <= 16 rays at once, into origin[0..n) and direction[0..n): the same
+    /// rays to the bit, lane by lane, as a loop that the compiler vectorises across the rays
+    /// where the camera does not turn (a turning camera's pose, `turned`, takes the loop over
+    /// generate()).
+    void generate(int n, const float* px, const float* py, const Vec2f* lens, const float* time, Vec3f* origin,
+                  Vec3f* direction) const;
+
     /// Image position (pixels) of a world point seen through the lens centre at shutter time t.
     Vec2f project(const Vec3f& p, float time = 0.f) const;
     /// Depth of a world point along forward, from the camera at shutter time t.

@@ -1,6 +1,8 @@
 #include "render/path_sampler.h"
 
 #include <algorithm>
+#include <bit>
+#include <cassert>
 #include <memory>
 
 #include "core/light_field.h"
@@ -11,6 +13,85 @@ namespace {
 
 /// The shading normal on the geometric normal's side (vn may be authored either way round).
 Vec3f facing(const Vec3f& shading, const Vec3f& geometric) { return dot(shading, geometric) < 0 ? -shading : shading; }
+
+/// samplePlanarLights' arithmetic once each sample's light is chosen (li[k]).
+template <class Sample>
+void kernelPlanarLights(int n, const int* __restrict li, const float* __restrict cdf, const Vec3f* __restrict corner,
+                        const Vec3f* __restrict edge1, const Vec3f* __restrict edge2, const Vec3f* __restrict normal,
+                        const Vec3f* __restrict radiance, const float* __restrict area,
+                        const int* __restrict triangle, const Vec3f* __restrict p, const Vec3f* __restrict nrm,
+                        const Vec2f* __restrict u, Sample* __restrict out) {
+    for (int k = 0; k < n; ++k) {
+        const int i = li[k];
+        const float pChoice = cdf[i + 1] - cdf[i];  // sampleLight's, to the bit (x - 0 = x)
+        const bool fold = triangle[i] && u[k].x + u[k].y > 1.f;  // AreaLight::pointAt
+        const float a = fold ? 1.f - u[k].x : u[k].x, b = fold ? 1.f - u[k].y : u[k].y;
+        const Vec3f point = corner[i] + edge1[i] * a + edge2[i] * b;
+        const Vec3f w = point - p[k];
+        const float distance = length(w);
+        const Vec3f toLight = w / distance;
+        const float cosX = dot(nrm[k], toLight);
+        const float cosY = -dot(normal[i], toLight);
+        const bool dark = cosX <= 0 || cosY <= 0 || distance <= 0;
+        const float e = cosX * cosY / (distance * distance) * area[i] / pChoice;
+        const Vec3f r = radiance[i];
+        // Member by member: a Vec3f's copy is one statement the vectoriser does not split.
+        Sample& s = out[k];
+        s.point.x = point.x, s.point.y = point.y, s.point.z = point.z;
+        s.toLight.x = toLight.x, s.toLight.y = toLight.y, s.toLight.z = toLight.z;
+        s.distance = distance;
+        s.light = uint32_t(i);
+        s.irradiance.x = dark ? 0.f : r.x * e, s.irradiance.y = dark ? 0.f : r.y * e, s.irradiance.z = dark ? 0.f : r.z * e;
+    }
+}
+
+/// For lanes l < n: the cosine-weighted bounce direction about the shading normal and its dot
+/// product with the geometric normal (<= 0: into the facet), as a loop across the lanes that the
+/// compiler vectorises (lanes without a hit take their dummy normals and are skipped after).
+void bounceDirections(int n, const Vec3f* __restrict normal, const Vec3f* __restrict geometric,
+                      const Vec2f* __restrict u, Vec3f* __restrict dir, float* __restrict intoFacet) {
+    for (int l = 0; l < n; ++l) {
+        const Vec3f d = Frame(normal[l]).toWorld(cosineHemisphere(u[l].x, u[l].y));
+        dir[l].x = d.x, dir[l].y = d.y, dir[l].z = d.z;  // (member by member: see kernelPlanarLights)
+        intoFacet[l] = dot(d, geometric[l]);
+    }
+}
+
+/// The per-light data sampleLight reads, as tables by light index (PathSampler::sampleLights).
+struct PlanarLights {
+    int count;
+    const float* cdf;  // cdf[i + 1]: the cumulative share of lights 0..i; cdf[0] = 0
+    const Vec3f *corner, *edge1, *edge2, *normal, *radiance;
+    const float* area;
+    const int* triangle;  // 1 for a triangle (int: a gather of bytes does not vectorise)
+};
+
+/// PathSampler::sampleLight's arithmetic, in its order, for samples k < n on planar lights, as
+/// loops across the samples that the compiler vectorises (the per-light data gathered by index):
+/// the same samples to the bit. (The pointers are __restrict parameters, so that the gathers
+/// need no run-time check against the stores.)
+template <class Sample>
+void samplePlanarLights(const PlanarLights& lights, int n, const Vec3f* __restrict p, const Vec3f* __restrict nrm,
+                        const Vec2f* __restrict u, const float* __restrict choice, Sample* __restrict out) {
+    assert(n <= PathSampler::kLightBatch);
+    int li[PathSampler::kLightBatch];  // (signed: the gathers' indices)
+    const int count = lights.count;
+    const float* __restrict cdf = lights.cdf;
+    for (int k = 0; k < n; ++k) li[k] = 0;
+    if (count > 1) {
+        // upper_bound as the count of cumulative shares <= choice, found bit by bit from the
+        // highest (the same index for a sorted table), then the last light for rounding's sake.
+        for (int step = int(std::bit_floor(uint32_t(count))); step > 0; step >>= 1)
+            for (int k = 0; k < n; ++k) {
+                const int j = li[k] + step;
+                const float share = cdf[std::min(j, count)];
+                li[k] = (j <= count) & (share <= choice[k]) ? j : li[k];
+            }
+        for (int k = 0; k < n; ++k) li[k] = std::min(li[k], count - 1);
+    }
+    kernelPlanarLights(n, li, cdf, lights.corner, lights.edge1, lights.edge2, lights.normal, lights.radiance,
+                       lights.area, lights.triangle, p, nrm, u, out);
+}
 
 }  // namespace
 
@@ -25,8 +106,16 @@ PathSampler::PathSampler(const scene::Scene& scene, const Camera& camera, bool i
         m_lightCdf.push_back(total);
         m_lightNormal.push_back(l.sphere() ? Vec3f(0.f) : l.normal());
         m_lightArea.push_back(l.area());
+        m_lightCorner.push_back(l.corner);
+        m_lightEdge1.push_back(l.edge1);
+        m_lightEdge2.push_back(l.edge2);
+        m_lightRadiance.push_back(l.radiance);
+        m_lightTriangle.push_back(l.triangle() ? 1 : 0);
+        m_anySphere = m_anySphere || l.sphere();
     }
     for (float& c : m_lightCdf) c /= total;
+    m_lightCdfFrom0.push_back(0.f);
+    m_lightCdfFrom0.insert(m_lightCdfFrom0.end(), m_lightCdf.begin(), m_lightCdf.end());
     // The lights the filters see (scene::lightGroups) and their centroids.
     const auto& lights = scene.desc().lights;
     for (size_t i = 0; i < lights.size(); ++i) {
@@ -103,6 +192,19 @@ PathSampler::LightSample PathSampler::sampleLight(const Vec3f& p, const Vec3f& n
     return s;
 }
 
+void PathSampler::sampleLights(int n, const Vec3f* p, const Vec3f* nrm, const Vec2f* u, const float* choice,
+                               LightSample* out) const {
+    if (m_anySphere) {
+        for (int k = 0; k < n; ++k) out[k] = sampleLight(p[k], nrm[k], u[k], choice[k]);
+        return;
+    }
+    assert(n <= kLightBatch);
+    const PlanarLights lights{int(m_lightCdf.size()), m_lightCdfFrom0.data(), m_lightCorner.data(), m_lightEdge1.data(),
+                              m_lightEdge2.data(), m_lightNormal.data(), m_lightRadiance.data(), m_lightArea.data(),
+                              m_lightTriangle.data()};
+    samplePlanarLights(lights, n, p, nrm, u, choice, out);
+}
+
 PathSampler::LightSample PathSampler::sampleSphere(const scene::AreaLight& light, uint32_t index, const Vec3f& p,
                                                    const Vec3f& n, Vec2f u, float pChoice) const {
     // Uniform in the cone of directions the sphere fills seen from p (half-angle alpha, sin alpha
@@ -173,13 +275,24 @@ void PathSampler::cameraRays(const PixelSampler& rng, int x, int y, uint32_t fir
         if (uLight) rng.get2DBatch(first, uint32_t(n), kLight, uLight);
         std::fill(uChoice, uChoice + n, Vec2f{0, 0});
     }
+    // Loops the compiler vectorises across the samples (Camera::generate's batch too).
+    float px[K], py[K];
     for (int k = 0; k < n; ++k) {
         choice[k] = uChoice[k].x;
         time[k] = uChoice[k].y;
-        lens[k] = m_camera.hasLens() ? concentricDisc(uLens[k].x, uLens[k].y) : Vec2f{0, 0};
-        if (film) film[k] = uPix[k];
-        Ray ray = m_camera.generate(float(x) + uPix[k].x, float(y) + uPix[k].y, lens[k], time[k]);
-        primary.set(k, ray.origin, ray.direction, kInf, time[k]);
+        px[k] = float(x) + uPix[k].x;
+        py[k] = float(y) + uPix[k].y;
+    }
+    if (m_camera.hasLens())
+        for (int k = 0; k < n; ++k) lens[k] = concentricDisc(uLens[k].x, uLens[k].y);
+    else
+        std::fill(lens, lens + n, Vec2f{0, 0});
+    if (film) std::copy(uPix, uPix + n, film);
+    m_camera.generate(n, px, py, lens, time, primary.org, primary.dir);
+    for (int k = 0; k < n; ++k) {
+        primary.valid[k] = -1;
+        primary.tFar[k] = kInf;
+        primary.time[k] = time[k];
     }
 }
 
@@ -188,7 +301,7 @@ void PathSampler::cameraRays(const PixelSampler& rng, int x, int y, uint32_t fir
 /// then each of the other three kinds of ray (shadow, bounce, the bounce's shadow) as one
 /// Embree stream. Kept per thread and reused.
 struct PathSampler::Wave {
-    static constexpr int kLanes = 256;
+    static constexpr int kLanes = kLightBatch;
     TracedSample* out[kLanes];
     float time[kLanes], choice[kLanes];
     Vec3f normal[kLanes], geometric[kLanes];  // shading and geometric normals, on the side the ray came from
@@ -206,6 +319,16 @@ struct PathSampler::Wave {
     uint16_t lane[kLanes];
     bool occluded[kLanes];
     scene::OccluderSpan spans[kLanes];
+    // Where a batch of light samples is taken (PathSampler::sampleLights): the points, their
+    // normals, numbers and light choices; for the bounces, which bounce each is and its facet.
+    Vec3f at[kLanes], atNormal[kLanes], g2[kLanes];
+    Vec2f atU[kLanes];
+    float atChoice[kLanes];
+    uint16_t atBounce[kLanes];
+    LightSample atSample[kLanes];
+    // Each lane's bounce direction and its dot product with the facet's normal (bounceDirections).
+    Vec3f bounceDir[kLanes];
+    float intoFacet[kLanes];
     int nRays = 0;
     /// Queues the shadow ray of lane (or bounce) l from `org` to just short of `lightPoint`.
     void pushShadow(int l, const Vec3f& org, const Vec3f& lightPoint, float t) {
@@ -274,7 +397,7 @@ void PathSampler::traceMany(const SampleRun* runs, size_t nRuns, bool span) cons
             cameraRays(rng, run.x, run.y, first, n, primary, lens, w.choice + l0, w.time + l0, w.uLight + l0, film);
             for (int k = 0; k < n; ++k) {
                 w.out[l0 + k] = out + k;
-                out[k] = TracedSample();
+                std::construct_at(out + k);  // in place: a temporary assigned stalled on store forwarding (7% of traceMany)
                 out[k].record.lens = lens[k];
                 out[k].film = film[k];
                 out[k].time = w.time[l0 + k];
@@ -334,7 +457,19 @@ void PathSampler::traceMany(const SampleRun* runs, size_t nRuns, bool span) cons
                     }
                 }
                 if (front) o.emission = mat.emission;  // emitters shine from their front side
-                const LightSample& ls = w.ls[l] = sampleLight(hit.position, w.normal[l], w.uLight[l], w.choice[l]);
+                w.at[l] = hit.position;
+            }
+            // The batch's light samples together (lanes without a hit take a dummy and are skipped).
+            for (int k = 0; k < n; ++k)
+                if (!w.found[l0 + k])
+                    w.at[l0 + k] = Vec3f(0.f), w.normal[l0 + k] = w.geometric[l0 + k] = Vec3f(0.f, 0.f, 1.f);
+            sampleLights(n, w.at + l0, w.normal + l0, w.uLight + l0, w.choice + l0, w.ls + l0);
+            for (int k = 0; k < n; ++k) {
+                const int l = l0 + k;
+                if (!w.found[l]) continue;
+                const scene::Hit& hit = w.hit[l];
+                TracedSample& o = out[k];
+                const LightSample& ls = w.ls[l];
                 o.record.light = m_group[ls.light];
                 o.record.lightPoint = ls.point;
                 if (maxComponent(ls.irradiance) <= 0) continue;
@@ -377,10 +512,11 @@ void PathSampler::traceMany(const SampleRun* runs, size_t nRuns, bool span) cons
             // as fast as one by one in Embree, bench/embree_ceiling.cpp, and their hits' data is
             // then fetched together), each hit lit by its own light sample.
             int nBounce = 0;
+            bounceDirections(lanes, w.normal, w.geometric, w.uBounce, w.bounceDir, w.intoFacet);
             for (int l = 0; l < lanes; ++l) {
                 if (!w.found[l] || maxComponent(w.hit[l].albedo) <= 0) continue;
-                const Vec3f dir = Frame(w.normal[l]).toWorld(cosineHemisphere(w.uBounce[l].x, w.uBounce[l].y));
-                if (dot(dir, w.geometric[l]) <= 0) continue;  // into the facet: no light comes that way
+                const Vec3f dir = w.bounceDir[l];
+                if (w.intoFacet[l] <= 0) continue;  // into the facet: no light comes that way
                 w.out[l]->record.bounceDir = dir;
                 ++w.out[l]->rays;
                 w.bounce[nBounce] = {offset(w.hit[l].position, w.geometric[l]), dir, kInf, w.time[l]};
@@ -389,6 +525,7 @@ void PathSampler::traceMany(const SampleRun* runs, size_t nRuns, bool span) cons
             if (m_log) m_log->add(scene::RayLog::kBounce, w.bounce, size_t(nBounce));
             m_scene.intersect(w.bounce, size_t(nBounce), w.h2, w.found2);
             w.nRays = 0;
+            int nLit = 0;  // the bounces whose hit takes a light sample
             for (int j = 0; j < nBounce; ++j) {
                 if (!w.found2[j]) continue;
                 const int l = w.bounceLane[j];
@@ -397,13 +534,22 @@ void PathSampler::traceMany(const SampleRun* runs, size_t nRuns, bool span) cons
                 o.bounceHit = true;
                 o.bounceDistance = h2.t;
                 if (maxComponent(h2.albedo) <= 0) continue;
-                const Vec3f g2 = dot(h2.normal, w.bounce[j].dir) < 0 ? h2.normal : -h2.normal;
-                const LightSample& l2 = w.l2[j] =
-                    sampleLight(h2.position, facing(h2.shadingNormal, g2), w.uBounceLight[l], w.choice[l]);
-                if (maxComponent(l2.irradiance) <= 0 || dot(l2.toLight, g2) <= 0) continue;
+                const Vec3f g2 = w.g2[j] = dot(h2.normal, w.bounce[j].dir) < 0 ? h2.normal : -h2.normal;
+                w.at[nLit] = h2.position;
+                w.atNormal[nLit] = facing(h2.shadingNormal, g2);
+                w.atU[nLit] = w.uBounceLight[l];
+                w.atChoice[nLit] = w.choice[l];
+                w.atBounce[nLit++] = uint16_t(j);
+            }
+            sampleLights(nLit, w.at, w.atNormal, w.atU, w.atChoice, w.atSample);
+            for (int i = 0; i < nLit; ++i) {
+                const int j = w.atBounce[i];
+                const int l = w.bounceLane[j];
+                const LightSample& l2 = w.l2[j] = w.atSample[i];
+                if (maxComponent(l2.irradiance) <= 0 || dot(l2.toLight, w.g2[j]) <= 0) continue;
                 ++lit;
-                w.pushShadow(j, offset(h2.position, g2), l2.point, w.time[l]);
-                ++o.rays;
+                w.pushShadow(j, offset(w.h2[j].position, w.g2[j]), l2.point, w.time[l]);
+                ++w.out[l]->rays;
             }
             if (m_log) m_log->add(scene::RayLog::kBounceShadow, w.rays, size_t(w.nRays));
             m_scene.occluded(w.rays, size_t(w.nRays), w.occluded);

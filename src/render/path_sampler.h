@@ -147,16 +147,25 @@ public:
     /// (scene::LightIrradiance, built once with the sampler's light groups).
     Vec3f unoccludedIrradiance(const Vec3f& x, const Vec3f& n) const { return m_irradiance(x, n); }
 
-private:
-    struct Wave;
+    /// One light sample for a point p with normal n: a light chosen by `choice` in proportion to
+    /// its power, a point on it from u, and what it gives p without visibility.
     struct LightSample {
         Vec3f point;
         Vec3f irradiance;  // E: radiance * cos * cos / r^2 / pdf, zero if facing away
         Vec3f toLight;     // unit
         float distance;
-        uint32_t light;
+        uint32_t light;    // the scene light
     };
     LightSample sampleLight(const Vec3f& p, const Vec3f& n, Vec2f u, float choice) const;
+    /// The most samples a wave holds, and a batch of light samples.
+    static constexpr int kLightBatch = 256;
+    /// sampleLight(p[k], nrm[k], u[k], choice[k]) into out[k] for k < n <= kLightBatch: the same
+    /// samples to the bit, as loops across them that the compiler vectorises (where no light is
+    /// a sphere; else one by one).
+    void sampleLights(int n, const Vec3f* p, const Vec3f* nrm, const Vec2f* u, const float* choice, LightSample* out) const;
+
+private:
+    struct Wave;
     /// sampleLight's sample of a sphere light (`index`), chosen with probability pChoice.
     LightSample sampleSphere(const scene::AreaLight& light, uint32_t index, const Vec3f& p, const Vec3f& n, Vec2f u,
                              float pChoice) const;
@@ -185,6 +194,10 @@ private:
     std::vector<float> m_lightCdf;     // light choice proportional to power
     std::vector<Vec3f> m_lightNormal;  // each light's normal() and area(), once (sampleLight's hot loop)
     std::vector<float> m_lightArea;
+    std::vector<Vec3f> m_lightCorner, m_lightEdge1, m_lightEdge2, m_lightRadiance;  // sampleLights' tables
+    std::vector<int> m_lightTriangle;
+    std::vector<float> m_lightCdfFrom0;  // 0, then m_lightCdf
+    bool m_anySphere = false;
     std::vector<uint32_t> m_group;     // scene light -> its group, the ViewGeometry light (scene::lightGroups)
     std::vector<Vec3f> m_groupCenter;  // each group's centroid
     std::vector<float> m_groupArea;
