@@ -14,15 +14,16 @@ namespace {
 /// The shading normal on the geometric normal's side (vn may be authored either way round).
 Vec3f facing(const Vec3f& shading, const Vec3f& geometric) { return dot(shading, geometric) < 0 ? -shading : shading; }
 
-/// samplePlanarLights' arithmetic once each sample's light is chosen (li[k]).
-template <class Sample>
+/// samplePlanarLights' arithmetic once each sample's light is chosen (li[k]; with kOne, the
+/// scene's only light, whose data the loop then reads once instead of gathering it).
+template <bool kOne, class Sample>
 void kernelPlanarLights(int n, const int* __restrict li, const float* __restrict cdf, const Vec3f* __restrict corner,
                         const Vec3f* __restrict edge1, const Vec3f* __restrict edge2, const Vec3f* __restrict normal,
                         const Vec3f* __restrict radiance, const float* __restrict area,
                         const int* __restrict triangle, const Vec3f* __restrict p, const Vec3f* __restrict nrm,
                         const Vec2f* __restrict u, Sample* __restrict out) {
     for (int k = 0; k < n; ++k) {
-        const int i = li[k];
+        const int i = kOne ? 0 : li[k];
         const float pChoice = cdf[i + 1] - cdf[i];  // sampleLight's, to the bit (x - 0 = x)
         const bool fold = triangle[i] && u[k].x + u[k].y > 1.f;  // AreaLight::pointAt
         const float a = fold ? 1.f - u[k].x : u[k].x, b = fold ? 1.f - u[k].y : u[k].y;
@@ -89,8 +90,12 @@ void samplePlanarLights(const PlanarLights& lights, int n, const Vec3f* __restri
             }
         for (int k = 0; k < n; ++k) li[k] = std::min(li[k], count - 1);
     }
-    kernelPlanarLights(n, li, cdf, lights.corner, lights.edge1, lights.edge2, lights.normal, lights.radiance,
-                       lights.area, lights.triangle, p, nrm, u, out);
+    if (count == 1)
+        kernelPlanarLights<true>(n, li, cdf, lights.corner, lights.edge1, lights.edge2, lights.normal, lights.radiance,
+                                 lights.area, lights.triangle, p, nrm, u, out);
+    else
+        kernelPlanarLights<false>(n, li, cdf, lights.corner, lights.edge1, lights.edge2, lights.normal,
+                                  lights.radiance, lights.area, lights.triangle, p, nrm, u, out);
 }
 
 }  // namespace
