@@ -21,7 +21,7 @@ PACKED = r"\bv?(add|sub|mul|div|sqrt|min|max)ps\b|\bvfn?m(add|sub)\d+ps\b"
 CHECKS = [
     ("the layered reconstruction's rays", r"traceBlurredRays<", 8, PACKED),
     ("the camera rays of a batch", r"Camera::generate\(int,", 1, PACKED),
-    ("the light samples of a batch", r"samplePlanarLights<", 1, PACKED),
+    ("the light samples of a batch", r"samplePlanarLights\(", 1, PACKED),
     # traceMany's own arithmetic is scalar but for the bounce directions' loop (bounceDirections,
     # inlined): its packed square root is that loop's.
     ("the bounce directions of a wave", r"PathSampler::traceMany\(.*\) const$", 1, r"\bv?sqrtps\b"),

@@ -48,9 +48,12 @@ constexpr Vec3f cross(const Vec3f& a, const Vec3f& b) {
 }
 inline float length(const Vec3f& v) { return std::sqrt(dot(v, v)); }
 constexpr float lengthSquared(const Vec3f& v) { return dot(v, v); }
+/// (Selects per component, not a branch between two Vec3f: a loop over it then vectorises,
+/// render/camera.cpp's camera rays. The same values.)
 inline Vec3f normalize(const Vec3f& v) {
-    float l = length(v);
-    return l > 0 ? v / l : Vec3f(0.f);
+    const float l = length(v);
+    const bool ok = l > 0;
+    return {ok ? v.x / l : 0.f, ok ? v.y / l : 0.f, ok ? v.z / l : 0.f};
 }
 inline Vec3f vmin(const Vec3f& a, const Vec3f& b) { return {std::min(a.x, b.x), std::min(a.y, b.y), std::min(a.z, b.z)}; }
 inline Vec3f vmax(const Vec3f& a, const Vec3f& b) { return {std::max(a.x, b.x), std::max(a.y, b.y), std::max(a.z, b.z)}; }

@@ -26,17 +26,6 @@ Camera::Pose Camera::turned(const Vec3f& position, const Vec3f& lookAt) const {
     return p;
 }
 
-namespace {
-
-/// normalize() as selects, which the vectoriser takes (its branch between two Vec3f it does not).
-inline Vec3f normalizeSelect(const Vec3f& v) {
-    const float l = length(v);
-    const bool ok = l > 0;
-    return {ok ? v.x / l : 0.f, ok ? v.y / l : 0.f, ok ? v.z / l : 0.f};
-}
-
-}  // namespace
-
 void Camera::generate(int n, const float* px, const float* py, const Vec2f* lens, const float* time, Vec3f* origin,
                       Vec3f* direction) const {
     if (m_turning) {
@@ -59,11 +48,11 @@ void Camera::generate(int n, const float* px, const float* py, const Vec2f* lens
             const Vec3f dirPinhole = f + r * xc + u * yc;
             Vec3f o = position, dir;
             if constexpr (!decltype(lensed)::value) {
-                dir = normalizeSelect(dirPinhole);
+                dir = normalize(dirPinhole);
             } else {
                 const Vec3f focus = position + dirPinhole * focusDistance;
                 o = position + (r * lens[k].x + u * lens[k].y) * aperture;
-                dir = normalizeSelect(focus - o);
+                dir = normalize(focus - o);
             }
             // Member by member: a Vec3f's copy is one statement the vectoriser does not split.
             origin[k].x = o.x, origin[k].y = o.y, origin[k].z = o.z;

@@ -16,15 +16,15 @@ Vec3f facing(const Vec3f& shading, const Vec3f& geometric) { return dot(shading,
 
 /// samplePlanarLights' arithmetic once each sample's light is chosen (li[k]; with kOne, the
 /// scene's only light, whose data the loop then reads once instead of gathering it).
-template <bool kOne, class Sample>
+template <bool kOne>
 void kernelPlanarLights(int n, const int* __restrict li, const float* __restrict cdf, const Vec3f* __restrict corner,
                         const Vec3f* __restrict edge1, const Vec3f* __restrict edge2, const Vec3f* __restrict normal,
                         const Vec3f* __restrict radiance, const float* __restrict area,
                         const int* __restrict triangle, const Vec3f* __restrict p, const Vec3f* __restrict nrm,
-                        const Vec2f* __restrict u, Sample* __restrict out) {
+                        const Vec2f* __restrict u, PathSampler::LightSample* __restrict out) {
     for (int k = 0; k < n; ++k) {
         const int i = kOne ? 0 : li[k];
-        const float pChoice = cdf[i + 1] - cdf[i];  // sampleLight's, to the bit (x - 0 = x)
+        const float pChoice = cdf[i + 1] - cdf[i];  // sampleLight's
         const bool fold = triangle[i] && u[k].x + u[k].y > 1.f;  // AreaLight::pointAt
         const float a = fold ? 1.f - u[k].x : u[k].x, b = fold ? 1.f - u[k].y : u[k].y;
         const Vec3f point = corner[i] + edge1[i] * a + edge2[i] * b;
@@ -37,7 +37,7 @@ void kernelPlanarLights(int n, const int* __restrict li, const float* __restrict
         const float e = cosX * cosY / (distance * distance) * area[i] / pChoice;
         const Vec3f r = radiance[i];
         // Member by member: a Vec3f's copy is one statement the vectoriser does not split.
-        Sample& s = out[k];
+        PathSampler::LightSample& s = out[k];
         s.point.x = point.x, s.point.y = point.y, s.point.z = point.z;
         s.toLight.x = toLight.x, s.toLight.y = toLight.y, s.toLight.z = toLight.z;
         s.distance = distance;
@@ -71,9 +71,9 @@ struct PlanarLights {
 /// loops across the samples that the compiler vectorises (the per-light data gathered by index):
 /// the same samples to the bit. (The pointers are __restrict parameters, so that the gathers
 /// need no run-time check against the stores.)
-template <class Sample>
 void samplePlanarLights(const PlanarLights& lights, int n, const Vec3f* __restrict p, const Vec3f* __restrict nrm,
-                        const Vec2f* __restrict u, const float* __restrict choice, Sample* __restrict out) {
+                        const Vec2f* __restrict u, const float* __restrict choice,
+                        PathSampler::LightSample* __restrict out) {
     assert(n <= PathSampler::kLightBatch);
     int li[PathSampler::kLightBatch];  // (signed: the gathers' indices)
     const int count = lights.count;
@@ -106,6 +106,7 @@ PathSampler::PathSampler(const scene::Scene& scene, const Camera& camera, bool i
     m_epsilon = 1e-5f * scene.extent();
     m_needChoice = scene.desc().lights.size() > 1 || scene.desc().hasMotion();
     float total = 0;
+    m_lightCdf.push_back(0.f);
     for (const auto& l : scene.desc().lights) {
         total += std::max(1e-12f, luminance(l.radiance) * l.area());
         m_lightCdf.push_back(total);
@@ -119,8 +120,6 @@ PathSampler::PathSampler(const scene::Scene& scene, const Camera& camera, bool i
         m_anySphere = m_anySphere || l.sphere();
     }
     for (float& c : m_lightCdf) c /= total;
-    m_lightCdfFrom0.push_back(0.f);
-    m_lightCdfFrom0.insert(m_lightCdfFrom0.end(), m_lightCdf.begin(), m_lightCdf.end());
     // The lights the filters see (scene::lightGroups) and their centroids.
     const auto& lights = scene.desc().lights;
     for (size_t i = 0; i < lights.size(); ++i) {
@@ -176,8 +175,8 @@ PathSampler::LightSample PathSampler::sampleLight(const Vec3f& p, const Vec3f& n
     const auto& lights = m_scene.desc().lights;
     // The first light whose cumulative share exceeds `choice` (the last one for rounding's sake).
     const uint32_t li = uint32_t(std::min<size_t>(
-        std::upper_bound(m_lightCdf.begin(), m_lightCdf.end(), choice) - m_lightCdf.begin(), lights.size() - 1));
-    float pChoice = m_lightCdf[li] - (li > 0 ? m_lightCdf[li - 1] : 0.f);
+        std::upper_bound(m_lightCdf.begin() + 1, m_lightCdf.end(), choice) - m_lightCdf.begin() - 1, lights.size() - 1));
+    const float pChoice = m_lightCdf[li + 1] - m_lightCdf[li];  // (the first light's: its share - 0, to the bit)
     const scene::AreaLight& light = lights[li];
     LightSample s;
     s.light = li;
@@ -203,8 +202,7 @@ void PathSampler::sampleLights(int n, const Vec3f* p, const Vec3f* nrm, const Ve
         for (int k = 0; k < n; ++k) out[k] = sampleLight(p[k], nrm[k], u[k], choice[k]);
         return;
     }
-    assert(n <= kLightBatch);
-    const PlanarLights lights{int(m_lightCdf.size()), m_lightCdfFrom0.data(), m_lightCorner.data(), m_lightEdge1.data(),
+    const PlanarLights lights{int(m_lightCdf.size()) - 1, m_lightCdf.data(), m_lightCorner.data(), m_lightEdge1.data(),
                               m_lightEdge2.data(), m_lightNormal.data(), m_lightRadiance.data(), m_lightArea.data(),
                               m_lightTriangle.data()};
     samplePlanarLights(lights, n, p, nrm, u, choice, out);
@@ -311,7 +309,7 @@ struct PathSampler::Wave {
     float time[kLanes], choice[kLanes];
     Vec3f normal[kLanes], geometric[kLanes];  // shading and geometric normals, on the side the ray came from
     Vec2f uLight[kLanes], uBounce[kLanes], uBounceLight[kLanes];
-    LightSample ls[kLanes], l2[kLanes];
+    LightSample ls[kLanes];
     scene::Hit hit[kLanes];
     bool found[kLanes];
     // The bounce rays (a stream), the lane of each, their hits and light samples.
@@ -319,14 +317,15 @@ struct PathSampler::Wave {
     uint16_t bounceLane[kLanes];
     scene::Hit h2[kLanes];
     bool found2[kLanes];
-    // A stream of shadow rays and the lane (or the bounce) each belongs to.
+    // A stream of shadow rays and the lane (or the bounce hit's light sample, atSample) each belongs to.
     scene::RaySegment rays[kLanes];
     uint16_t lane[kLanes];
     bool occluded[kLanes];
     scene::OccluderSpan spans[kLanes];
     // Where a batch of light samples is taken (PathSampler::sampleLights): the points, their
-    // normals, numbers and light choices; for the bounces, which bounce each is and its facet.
-    Vec3f at[kLanes], atNormal[kLanes], g2[kLanes];
+    // normals, numbers and light choices; for the bounces' hits, which bounce each is, its facet's
+    // normal and the sample taken there.
+    Vec3f at[kLanes], atNormal[kLanes], atFacet[kLanes];
     Vec2f atU[kLanes];
     float atChoice[kLanes];
     uint16_t atBounce[kLanes];
@@ -335,7 +334,7 @@ struct PathSampler::Wave {
     Vec3f bounceDir[kLanes];
     float intoFacet[kLanes];
     int nRays = 0;
-    /// Queues the shadow ray of lane (or bounce) l from `org` to just short of `lightPoint`.
+    /// Queues the shadow ray of lane (or light sample) l from `org` to just short of `lightPoint`.
     void pushShadow(int l, const Vec3f& org, const Vec3f& lightPoint, float t) {
         const Vec3f toPoint = lightPoint - org;
         const float dist = length(toPoint);
@@ -539,7 +538,7 @@ void PathSampler::traceMany(const SampleRun* runs, size_t nRuns, bool span) cons
                 o.bounceHit = true;
                 o.bounceDistance = h2.t;
                 if (maxComponent(h2.albedo) <= 0) continue;
-                const Vec3f g2 = w.g2[j] = dot(h2.normal, w.bounce[j].dir) < 0 ? h2.normal : -h2.normal;
+                const Vec3f g2 = w.atFacet[nLit] = dot(h2.normal, w.bounce[j].dir) < 0 ? h2.normal : -h2.normal;
                 w.at[nLit] = h2.position;
                 w.atNormal[nLit] = facing(h2.shadingNormal, g2);
                 w.atU[nLit] = w.uBounceLight[l];
@@ -548,22 +547,22 @@ void PathSampler::traceMany(const SampleRun* runs, size_t nRuns, bool span) cons
             }
             sampleLights(nLit, w.at, w.atNormal, w.atU, w.atChoice, w.atSample);
             for (int i = 0; i < nLit; ++i) {
-                const int j = w.atBounce[i];
-                const int l = w.bounceLane[j];
-                const LightSample& l2 = w.l2[j] = w.atSample[i];
-                if (maxComponent(l2.irradiance) <= 0 || dot(l2.toLight, w.g2[j]) <= 0) continue;
+                const int l = w.bounceLane[w.atBounce[i]];
+                const LightSample& l2 = w.atSample[i];
+                if (maxComponent(l2.irradiance) <= 0 || dot(l2.toLight, w.atFacet[i]) <= 0) continue;
                 ++lit;
-                w.pushShadow(j, offset(w.h2[j].position, w.g2[j]), l2.point, w.time[l]);
+                w.pushShadow(i, offset(w.at[i], w.atFacet[i]), l2.point, w.time[l]);
                 ++w.out[l]->rays;
             }
             if (m_log) m_log->add(scene::RayLog::kBounceShadow, w.rays, size_t(w.nRays));
             m_scene.occluded(w.rays, size_t(w.nRays), w.occluded);
-            for (int i = 0; i < w.nRays; ++i) {
-                if (w.occluded[i]) continue;
-                const int j = w.lane[i];  // the bounce
+            for (int r = 0; r < w.nRays; ++r) {
+                if (w.occluded[r]) continue;
+                const int i = w.lane[r];  // the light sample
+                const int j = w.atBounce[i];  // the bounce
                 // Cosine-weighted bounce: (albedo/pi) L cos / (cos/pi) = albedo L, so the
                 // demodulated indirect is the incident radiance L = albedo2 E2 / pi.
-                w.out[w.bounceLane[j]]->record.indirect = w.h2[j].albedo * w.l2[j].irradiance * kInvPi;
+                w.out[w.bounceLane[j]]->record.indirect = w.h2[j].albedo * w.atSample[i].irradiance * kInvPi;
             }
         }
         for (int l = 0; l < lanes; ++l) {

@@ -191,12 +191,11 @@ private:
     bool m_needChoice;  // light choice or shutter time vary
     mutable std::atomic<uint64_t> m_nonFinite{0};
     mutable std::atomic<uint64_t> m_lit{0};
-    std::vector<float> m_lightCdf;     // light choice proportional to power
+    std::vector<float> m_lightCdf;     // light choice by power: [i + 1] the cumulative share of lights 0..i, [0] = 0
     std::vector<Vec3f> m_lightNormal;  // each light's normal() and area(), once (sampleLight's hot loop)
     std::vector<float> m_lightArea;
     std::vector<Vec3f> m_lightCorner, m_lightEdge1, m_lightEdge2, m_lightRadiance;  // sampleLights' tables
     std::vector<int> m_lightTriangle;
-    std::vector<float> m_lightCdfFrom0;  // 0, then m_lightCdf
     bool m_anySphere = false;
     std::vector<uint32_t> m_group;     // scene light -> its group, the ViewGeometry light (scene::lightGroups)
     std::vector<Vec3f> m_groupCenter;  // each group's centroid
