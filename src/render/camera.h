@@ -41,8 +41,9 @@ public:
         return {origin, normalize(focus - origin)};
     }
 
-    /// generate() for n <= 16 rays at once, into origin[0..n) and direction[0..n): the same
-    /// rays to the bit, lane by lane, as a loop that the compiler vectorises across the rays
+    /// generate() for n <= 16 rays at once, into origin[0..n) and direction[0..n): its
+    /// arithmetic in its order, lane by lane (the same bits where both are compiled alike, as in
+    /// camera.cpp; render_test compares to rounding), as a loop that the compiler vectorises across the rays
     /// where the camera does not turn (a turning camera's pose, `turned`, takes the loop over
     /// generate()).
     void generate(int n, const float* px, const float* py, const Vec2f* lens, const float* time, Vec3f* origin,
