@@ -865,10 +865,14 @@ TEST(Layers, ConsecutiveSharpLayersMergeAndTheImageStaysTheSame) {
                                             {0.f, 0.f}, Vec3f(1.f), Vec3f(0.1f + 0.3f * float(plane) + 0.2f * uni(rng)), 0);
         }
     }
-    filter::LayerOptions apart;
+    // (Sharp, each of them, with no band: at the default sharpBand the 1.2-px plane blends its
+    // grid in.)
+    filter::LayerOptions together;
+    together.sharpBand = 1.f;
+    filter::LayerOptions apart = together;
     apart.mergeSharp = false;
     filter::LayerStats merged, separate;
-    const Image3f a = filter::reconstructLayers(filter::LayerInput{lf, view, {}}, filter::LayerOptions{}, &merged);
+    const Image3f a = filter::reconstructLayers(filter::LayerInput{lf, view, {}}, together, &merged);
     const Image3f b = filter::reconstructLayers(filter::LayerInput{lf, view, {}}, apart, &separate);
     EXPECT_EQ(merged.layersPerTile, 1.0);
     EXPECT_EQ(separate.layersPerTile, 3.0);
@@ -943,7 +947,11 @@ TEST(Layers, SharpLayersDoNotMergeAcrossAMovingLayerBetweenThem) {
         const Vec2f m = depth == band ? Vec2f{motion, 0.f} : Vec2f{0.f, 0.f};
         return LightFieldSample::pack(film, lens, t, depth, m, Vec3f(1.f), Vec3f(float(value(fx, t))), 0);
     });
-    const Image3f out = filter::reconstructLayers(filter::LayerInput{lf, view, {}});
+    // (The fixture's samples see what lies at their film position, whatever their lens point:
+    // the post and the wall must be sharp layers, their pixels' own samples, with no band.)
+    filter::LayerOptions o;
+    o.sharpBand = 1.f;
+    const Image3f out = filter::reconstructLayers(filter::LayerInput{lf, view, {}}, o);
     double worst = 0;
     int worstX = -1;
     for (int x = 2; x < W - 2; ++x) {
@@ -1588,6 +1596,51 @@ TEST(Layers, ADefocusedStillLayersNoiseIsSmoothedWhereAsked) {
     }
     EXPECT_LT(rms[1], 0.7 * rms[0]) << "the RMS noise with the edge-stopping Gaussian against without";
     EXPECT_NEAR(mean[1], 0.5, 0.005);
+}
+
+TEST(Layers, AWallCrossingTheSharpThresholdTurnsFromItsOwnSamplesToItsGridGradually) {
+    // A wall slanting away from the focal plane, its slope rising from 0 to 2.5 px across the
+    // image, its samples' radiance noisy about 0.5 (0.5 x (1 + v), v uniform in [-0.8, 0.8]):
+    // with a step at the sharp threshold (sharpBand 1: |c| 1.41 px) the noise of the columns
+    // just below it is their own samples', just above it the grid's, a seam where the layers
+    // turn blurred (docs/layers.md, "A seam where a tile's layer turns sharp"). With the band
+    // the grid's share rises with each pixel's blur radius from focus to the threshold. Per
+    // 8-column block, the RMS about 0.5 over the middle rows: measured, the largest ratio of the
+    // RMS of two blocks 16 px apart 2.64 with the step (0.060 -> 0.023 where the layers turn
+    // blurred), 1.64 with the band (far past the threshold, at x = 152-176, where both are the
+    // grid alone and alike); every block's mean within 0.01 of 0.5 with either.
+    const int W = 192, H = 48;
+    const ViewGeometry view = wideLensView(W, H);
+    auto depthOf = [](float slope) { return 10.f / (slope + 5.f); };  // 10 / d - 5 = slope
+    ASSERT_NEAR(view.defocusSlope(depthOf(1.5f)), 1.5f, 1e-4f);
+    double worst[2];
+    for (int k = 0; k < 2; ++k) {
+        std::mt19937 noise(7);
+        std::uniform_real_distribution<float> v(-0.8f, 0.8f);
+        const LightFieldSamples lf = randomLightField<true>(W, H, 16, 8, [&](int x, int, Vec2f film, float t, Vec2f lens) {
+            const float depth = depthOf(2.5f * (float(x) + film.x) / float(W));
+            return LightFieldSample::pack({float(x) + film.x, film.y}, lens, t, depth, {0.f, 0.f}, Vec3f(1.f), Vec3f(0.5f * (1.f + v(noise))), 0);
+        });
+        filter::LayerOptions o;
+        o.sharpBand = k == 0 ? 1.f : 0.f;
+        const Image3f out = filter::reconstructLayers(filter::LayerInput{lf, view, {}}, o);
+        std::vector<double> rms;
+        for (int x0 = 0; x0 < W; x0 += 8) {
+            double squared = 0, sum = 0;
+            int pixels = 0;
+            for (int y = 8; y < H - 8; ++y)
+                for (int x = x0; x < x0 + 8; ++x) squared += sqr(out(x, y).x - 0.5), sum += out(x, y).x, ++pixels;
+            rms.push_back(std::sqrt(squared / pixels));
+            EXPECT_NEAR(sum / pixels, 0.5, 0.01) << "the block at x = " << x0 << ", sharpBand " << o.sharpBand;
+        }
+        worst[k] = 1;
+        for (size_t i = 2; i < rms.size(); ++i) worst[k] = std::max({worst[k], rms[i] / rms[i - 2], rms[i - 2] / rms[i]});
+        std::printf("sharpBand %g: RMS per block", double(o.sharpBand));
+        for (const double r : rms) std::printf(" %.4f", r);
+        std::printf(", largest ratio %.2f\n", worst[k]);
+    }
+    EXPECT_GT(worst[0], 2.2) << "the step at the threshold (the fixture shows the seam)";
+    EXPECT_LT(worst[1], 1.8) << "the band: the noise falls gradually";
 }
 
 TEST(Layers, ACrispLayersNoiseIsStillAveragedAcrossItsMotionAwayFromEdges) {

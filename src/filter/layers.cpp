@@ -144,12 +144,28 @@ constexpr Shaped kSegmentShape[16] = {
 constexpr float kCellBlur = 1.f / 12.f + 1.f / 6.f;
 /// ... the cells' alone: the blur across a crisp layer's motion (Layer::crisp).
 constexpr float kCellOnly = 1.f / 12.f;
+/// The true blur of a surface of slope c and screen motion `motion` (pixels), variance per axis
+/// (pixels^2): a disc of radius |c| (c^2 / 4) and a segment of length |m| (m^2 / 12).
+inline float trueBlurOf(float c, float motion) { return 0.25f * sqr(c) + sqr(motion) / 12.f; }
+/// The sharp threshold (pixels^2 per axis): the grid's own blur with the smallest Gaussian, times
+/// sharpShare.
+inline float sharpThreshold(const LayerOptions& o) { return o.sharpShare * (kCellBlur + sqr(o.sigmaMin)); }
+/// The grid's share of a pixel whose layer's samples there have mean slope c and whose layer
+/// moves by `motion` (the rest is its own samples', as a sharp layer's): 1 from the sharp
+/// threshold on, 0 below sharpBand times its blur radius (the square root of the true blur),
+/// linear in the radius between (LayerOptions::sharpBand). At sharpBand 1: 1 at and above the
+/// threshold, 0 below it.
+inline float sharpWeight(float c, float motion, const LayerOptions& o) {
+    const float b = trueBlurOf(c, motion), hi = sharpThreshold(o);
+    if (b >= hi) return 1.f;
+    const float radius = std::sqrt(b), top = std::sqrt(hi), foot = std::clamp(o.sharpBand, 0.f, 1.f) * top;
+    return radius <= foot ? 0.f : (radius - foot) / (top - foot);
+}
 /// Whether a layer of mean slope c, slopes spreading over `spread` and mean screen motion `motion`
-/// (pixels) is sharp: its true blur, a disc of radius |c| (c^2 / 4 per axis) and a segment of
-/// length |m| (m^2 / 12), below the grid's own with the smallest Gaussian.
+/// (pixels) is sharp: its pixels' own samples alone, the grid's share nil at its farthest slope.
+/// (At sharpBand 1: its true blur below the threshold.)
 inline bool isSharp(float c, float spread, float motion, const LayerOptions& o) {
-    const float trueBlur = 0.25f * sqr(std::abs(c) + 0.5f * spread) + sqr(motion) / 12.f;
-    return trueBlur < o.sharpShare * (kCellBlur + sqr(o.sigmaMin));
+    return sharpWeight(std::abs(c) + 0.5f * spread, motion, o) == 0.f;
 }
 
 /// Whether a sample's screen motion over the shutter puts it in a motion group (else it is still).
@@ -398,6 +414,12 @@ struct Layer {
     }
     bool sharp = true;
     bool sharpRun = false;  // several still layers, each sharp, merged into one (splitLayers)
+    // A blurred layer some of whose pixels lie in the sharp band (LayerOptions::sharpBand): per
+    // pixel of its tile (row-major from the tile's corner, ownX0 and ownY0, ownW wide), the grid's
+    // share w (sharpWeight of the pixel's mean slope) and, times 1 - w, the alpha and premultiplied
+    // light of the pixel's own samples, as a sharp layer's (Blend). Empty: the grid alone.
+    std::vector<float> own;
+    int ownX0 = 0, ownY0 = 0, ownW = 0;
     // The Gaussians of the sharp image (layers.h, step 2): sigma for the radiance and the motion,
     // sigmaCoverage (<= sigma) for N, D and the slope, whose grid blur the rays' shear is shaped for.
     float sigma = 0, sigmaCoverage = 0;
@@ -1241,6 +1263,12 @@ struct Lookup {
     float alpha = 0;
     Vec3f premultiplied{0.f};
 };
+/// What a blurred layer with a sharp band (Layer::own) mixes into its rays at one pixel: alpha
+/// w alpha_grid + (1 - w) alpha_own, light likewise; `alpha`, r, g, b hold (1 - w) times the
+/// pixel's own. The default is the grid alone, to the bit (x 1 + 0).
+struct Blend {
+    float w = 1.f, alpha = 0.f, r = 0.f, g = 0.f, b = 0.f;
+};
 /// The bilinear cells and weights of a blurred layer's lookup at sharp-image position p: between
 /// cell centres (at +1/2); along a crisp axis (Layer::crisp) the cell that holds p (weights 0
 /// and 1).
@@ -1432,8 +1460,9 @@ struct Rays {
 /// (kGrid: the layer has a motion grid, followed as above; a template parameter, since a
 /// runtime condition in the loop left its lookups masked, and GCC kept such loops scalar.)
 template <bool kFollow, bool kMoving, bool kGrid, bool kCurved>
-bool traceBlurredRays(const Layer& l, int index, Rays& ray, int j0, int j1) {
+bool traceBlurredRays(const Layer& l, int index, Rays& ray, int j0, int j1, const Blend& own) {
     const int cs = l.cellStride(), bins = l.timeBins;
+    const float ownW = own.w, ownA = own.alpha, ownR = own.r, ownG = own.g, ownB = own.b;
     const float* cell = l.cell.data();
     constexpr bool followMotion = kMoving && kGrid;
     // (The grids' and the shear table's bases in locals: gathers through the layer were not
@@ -1525,16 +1554,16 @@ bool traceBlurredRays(const Layer& l, int index, Rays& ray, int j0, int j1) {
                 bl += cell[c0 + 2] * w;
             }
         }
-        partial |= composite(ray, j, index, alpha, r, g, bl);
+        partial |= composite(ray, j, index, alpha * ownW + ownA, r * ownW + ownR, g * ownW + ownG, bl * ownW + ownB);
     }
     return partial != 0;
 }
 template <bool kFollow, bool kMoving, bool kCurved = false>
-bool traceBlurred(const Layer& l, int index, Rays& ray, int j0, int j1) {
+bool traceBlurred(const Layer& l, int index, Rays& ray, int j0, int j1, const Blend& own) {
     if constexpr (kMoving) {
-        if (!l.motionGrid.empty()) return traceBlurredRays<kFollow, true, true, kCurved>(l, index, ray, j0, j1);
+        if (!l.motionGrid.empty()) return traceBlurredRays<kFollow, true, true, kCurved>(l, index, ray, j0, j1, own);
     }
-    return traceBlurredRays<kFollow, kMoving, false, false>(l, index, ray, j0, j1);
+    return traceBlurredRays<kFollow, kMoving, false, false>(l, index, ray, j0, j1, own);
 }
 
 /// Samples behind a layer with a motion grid, for its D (the D pass of reconstructLayers): each
@@ -1615,7 +1644,8 @@ void orderLayers(const uint8_t* before, int n, int* order) {
 bool samplesSharpAndStill(const LightFieldSamples& lf, size_t p, const ViewGeometry& view, const LayerOptions& o, int surface) {
     bool sharp = true;
     lf.forEach(p, [&](const LightFieldSample& s) {
-        if (surface < 0 || s.surface() == surface) sharp = sharp && !movesOnScreen(s.motion()) && isSharp(slopeOf(s, view), 0.f, 0.f, o);
+        if (surface < 0 || s.surface() == surface)
+            sharp = sharp && !movesOnScreen(s.motion()) && trueBlurOf(slopeOf(s, view), 0.f) < sharpThreshold(o);  // (the threshold, not the band's foot)
     });
     return sharp;
 }
@@ -2160,6 +2190,9 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                     return rank[k] < rank[l];
                 };
                 bool anyBlurred = false;
+                // The sharp twins of the layers in the sharp band (below), and each layer's (-1: none).
+                std::vector<Layer> twins;
+                std::vector<int> twinOf(layers.size(), -1);
                 for (Layer& l : layers) {
                     const float spread = l.cMax - l.cMin;
                     const float motion = l.motionRms;
@@ -2180,7 +2213,8 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                     // reprojected: its pixels' own samples, unbiased.
                     const float sigma = std::clamp(o.sigmaScale * std::abs(l.c), o.sigmaMin, o.sigmaMax);
                     const float gridReach = std::abs(l.c) + chordReach(l.depthRate) * motion + 3.f * sigma;  // beyond the tile, the rays' cells
-                    l.sharp = l.sharpRun || gridReach + 1.f > float(o.maxGridMargin) || isSharp(l.c, spread, motion, o);
+                    const bool forcedSharp = l.sharpRun || gridReach + 1.f > float(o.maxGridMargin);
+                    l.sharp = forcedSharp || isSharp(l.c, spread, motion, o);
                     l.rayC = l.c, l.rayMx = l.mx, l.rayMy = l.my;
                     int lm = 0;
                     if (!l.sharp) {
@@ -2212,6 +2246,25 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                     l.timeBins = l.moving && !l.sharp ? kTimeBins : 1;
                     l.acc.assign(size_t(l.gw) * l.gh * l.accStride(), 0.f);
                     l.accD.assign(size_t(l.gw) * l.gh, 0.f);
+                    // The sharp band (LayerOptions::sharpBand): a blurred layer whose slope nearest
+                    // focus lies below the threshold also keeps its pixels' own samples, as a
+                    // sharp layer of the tile would (its twin), and each pixel blends the two by
+                    // its own slope (sharpWeight): a surface crossing the threshold turns from its
+                    // own samples to its grid gradually, not at a tile's or a layer's edge.
+                    const size_t k = size_t(&l - layers.data());
+                    if (!l.sharp && !forcedSharp && o.sharpBand < 1.f) {
+                        const float nearest = l.cMin <= 0.f && l.cMax >= 0.f ? 0.f : std::min(std::abs(l.cMin), std::abs(l.cMax));
+                        if (trueBlurOf(nearest, motion) < sharpThreshold(o)) {
+                            twinOf[k] = int(twins.size());
+                            Layer& t = twins.emplace_back();
+                            t.c = l.c, t.cMin = l.cMin, t.cMax = l.cMax, t.moving = l.moving, t.depthRate = l.depthRate;
+                            t.invDepthMax = l.invDepthMax, t.invDepthMin = l.invDepthMin;
+                            t.sharp = true, t.timeBins = 1;
+                            t.gx0 = X0, t.gy0 = Y0, t.gw = X1 - X0, t.gh = Y1 - Y0;
+                            t.acc.assign(size_t(t.gw) * t.gh * t.accStride(), 0.f);
+                            t.accD.assign(size_t(t.gw) * t.gh, 0.f);
+                        }
+                    }
                 }
                 blurredTotal += anyBlurred ? 1 : 0;
                 // Splat: N and D at the layer's shear, W and the radiance at the sample's own.
@@ -2335,6 +2388,22 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                     a[1] += radiance.x;
                     a[2] += radiance.y;
                     a[3] += radiance.z;
+                    if (const int tk = twinOf[size_t(sl)]; tk >= 0) {
+                        // Its layer's twin: as a sharp layer takes it, at its own position.
+                        Layer& t = twins[size_t(tk)];
+                        const int tc = t.cellIndex({s.x, s.y});
+                        if (tc < 0) continue;
+                        Vec3f own = radianceOf(s, t);
+                        if (!surfaceLayer.empty() && s.surface >= 0 && in.surfaceLight[s.surface] && in.surfaceAlbedo[s.surface]) {
+                            const int tp = tilePixel(s);
+                            if (tp >= 0 && surfaceLayer[size_t(tp) * kSurfaces + size_t(s.surface)] == sl)
+                                own = (*in.surfaceAlbedo[s.surface])[s.pixel] * (*in.surfaceLight[s.surface])[s.pixel];
+                        }
+                        float* ta = &t.acc[size_t(tc) * size_t(t.accStride())];
+                        ta[0] += 1.f, ta[1] += s.c;
+                        ta[2] += 1.f, ta[3] += own.x, ta[4] += own.y, ta[5] += own.z;
+                        t.accD[size_t(tc)] += 1.f;
+                    }
                 }
                 // D of the layers in front of a sample, at their shear (as Layer::sharpPosition):
                 // where it shows that they do not cover. Not that of a moving layer it lies in
@@ -2555,6 +2624,18 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                         flush(k);
                     }
                 }
+                // The twins' D: the samples behind their layers at their own positions, as a
+                // sharp layer's (the pass of the still layers above).
+                for (int k = 0; k < nLayers; ++k) {
+                    if (twinOf[size_t(k)] < 0) continue;
+                    Layer& t = twins[size_t(twinOf[size_t(k)])];
+                    const Layer& l = layers[size_t(k)];
+                    forEachBehind(k, X0, X1, Y0, Y1, [&](const Gathered& s, int sl) {
+                        if (farthest[size_t(sl)] >= l.invDepthMax && l.inFrontOfAll(s.invDepth, s.t)) return;
+                        const int ci = t.cellIndex({s.x, s.y});
+                        if (ci >= 0) t.accD[size_t(ci)] += 1.f;
+                    });
+                }
                 for (Layer& l : layers) {
                     // Each pass within the cells it can change (CellBox): the same sums.
                     const CellBox grid{0, 0, l.gw, l.gh};
@@ -2580,6 +2661,21 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                     resolveCells(l, l.sharp ? 0.5f : 0.05f, box.united(boxD).grown(kFillRings, kFillRings, l.gw, l.gh));
                     l.acc = std::vector<float>();
                     l.accD = std::vector<float>();
+                    if (const int tk = twinOf[size_t(&l - layers.data())]; tk >= 0) {
+                        // The pixels' own samples resolved as a sharp layer's, and per pixel
+                        // the grid's share by the slope of the layer's samples there (Blend).
+                        Layer& t = twins[size_t(tk)];
+                        resolveCells(t, 0.5f, CellBox{0, 0, t.gw, t.gh});
+                        const int tcs = t.cellStride();
+                        l.ownX0 = t.gx0, l.ownY0 = t.gy0, l.ownW = t.gw;
+                        l.own.resize(size_t(t.gw) * t.gh * 5);
+                        for (size_t i = 0; i < size_t(t.gw) * t.gh; ++i) {
+                            const float* c = &t.cell[i * size_t(tcs)];
+                            const float w = sharpWeight(c[tcs - 1], l.motionRms, o), keep = 1.f - w;
+                            float* b = &l.own[i * 5];
+                            b[0] = w, b[1] = keep * c[0], b[2] = keep * c[1], b[3] = keep * c[2], b[4] = keep * c[3];
+                        }
+                    }
                     l.buildCovered();
                     const float slopeReach = std::max({std::abs(l.cMin), std::abs(l.cMax), std::abs(l.rayC), std::abs(l.rayC + l.rayC2)});
                     const float chord = chordReach(l.depthRate);
@@ -2597,6 +2693,7 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                     // (Layer::rayExtent): the rays skip it, which changes nothing they find. (It
                     // stays in the pixel's list, whose layers decide how many rays it takes.)
                     bool skip;
+                    Blend blend;  // a blurred layer's pixel in the sharp band (Layer::own)
                 };
                 std::vector<Active> active;
                 std::vector<int> binActive;  // (timeOrder) per order bin, `active` in its order
@@ -2642,9 +2739,21 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                         // slope-only lookups, docs/layers.md).
                         active.clear();
                         for (const Layer& l : layers) {
+                            if (!l.own.empty()) {
+                                // In the sharp band: where the grid has no share the pixel's own
+                                // samples alone, as a sharp layer's, else both (Blend).
+                                const float* b = &l.own[(size_t(y - l.ownY0) * size_t(l.ownW) + size_t(x - l.ownX0)) * 5];
+                                const Blend blend{b[0], b[1], b[2], b[3], b[4]};
+                                if (blend.w == 0.f) {
+                                    if (blend.alpha > 0.f) active.push_back({&l, true, {blend.alpha, Vec3f(blend.r, blend.g, blend.b)}, false, blend});
+                                } else if (blend.alpha > 0.f || l.reaches(x, y)) {
+                                    active.push_back({&l, false, Lookup{}, !o.everyCell && !(blend.alpha > 0.f) && !l.reaches(x, y, l.rayExtent), blend});
+                                }
+                                continue;
+                            }
                             if (!l.reaches(x, y)) continue;
                             const bool fixed = l.sharp && l.timeBins == 1;
-                            active.push_back({&l, fixed, fixed ? lookupSharp(l, x, y, 0.5f) : Lookup{}, !o.everyCell && !l.sharp && !l.reaches(x, y, l.rayExtent)});
+                            active.push_back({&l, fixed, fixed ? lookupSharp(l, x, y, 0.5f) : Lookup{}, !o.everyCell && !l.sharp && !l.reaches(x, y, l.rayExtent), Blend{}});
                         }
                         // (timeOrder) The order of those layers in each order bin, and whether it
                         // is one for every bin.
@@ -2718,9 +2827,10 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                                     // there (one fixed-point step), shaped by the grid's blur.
                                     const bool follow = l.followsSlope(), moving = l.timeBins > 1;
                                     const bool arcs = moving && !l.sagGrid.empty() && !l.motionGrid.empty();
-                                    partial |= arcs ? (follow ? traceBlurred<true, true, true>(l, index, ray, j0, j1) : traceBlurred<false, true, true>(l, index, ray, j0, j1))
-                                             : follow ? (moving ? traceBlurred<true, true>(l, index, ray, j0, j1) : traceBlurred<true, false>(l, index, ray, j0, j1))
-                                                      : (moving ? traceBlurred<false, true>(l, index, ray, j0, j1) : traceBlurred<false, false>(l, index, ray, j0, j1));
+                                    const Blend& bl = a.blend;
+                                    partial |= arcs ? (follow ? traceBlurred<true, true, true>(l, index, ray, j0, j1, bl) : traceBlurred<false, true, true>(l, index, ray, j0, j1, bl))
+                                             : follow ? (moving ? traceBlurred<true, true>(l, index, ray, j0, j1, bl) : traceBlurred<true, false>(l, index, ray, j0, j1, bl))
+                                                      : (moving ? traceBlurred<false, true>(l, index, ray, j0, j1, bl) : traceBlurred<false, false>(l, index, ray, j0, j1, bl));
                                 }
                             }
                         };

@@ -43,10 +43,14 @@
 //    left out of D: alpha = N / D is the layer's coverage where it is not hidden. The grids are
 //    smoothed with a Gaussian of sigma = clamp(0.15 |c_l|, 0.5, 2) pixels, the coverage's (N, D)
 //    and the slopes' with one of clamp(0.15 |c_l|, 0.25, 2); cells without weight (the layer
-//    hidden there) are filled from their neighbours. A layer whose true blur (a disc of radius
-//    |c|, a segment of length |m|) is below the grid's own with the radiance's Gaussian is
-//    "sharp": not reprojected, its grid its pixels' own samples (for samples that carry their
-//    own radiance, below half the grid's own at 16 samples per pixel: LayerOptions::sharpShare).
+//    hidden there) are filled from their neighbours. A layer's true blur (a disc of radius |c|,
+//    a segment of length |m|) is set against the grid's own with the radiance's Gaussian (the
+//    sharp threshold; for samples that carry their own radiance, half of it at 16 samples per
+//    pixel: LayerOptions::sharpShare): a pixel whose samples of the layer lie at or above it
+//    takes the grid; below the band's foot (LayerOptions::sharpBand) its own samples of the
+//    layer, not reprojected; between, both, the grid's share rising linearly with their blur
+//    radius. A layer none of whose pixels takes its grid is "sharp": its grid is its pixels'
+//    own samples.
 //    Where the samples carry filtered light, a moving layer in focus whose samples move along
 //    one axis of the grid keeps the other axis crisp: the nearest cell there, and across the
 //    motion no Gaussian but the radiance's, stopped at edges (LayerOptions::crispAcrossMotion).
@@ -109,14 +113,27 @@ struct LayerOptions {
     // by 5%, cornell-sphere by 4%; docs/layers.md, "What the mixed pixels' error is made of".)
     float sigmaCoverageMin = 0.25f;
     float splitMin = 0.5f, splitScale = 0.15f;  // a layer's slopes spread at most max(splitMin, splitScale |c|)
-    // A layer is sharp (its pixels' own samples, not reprojected) while its true blur is below
-    // sharpShare times the grid's own with the smallest Gaussian (kCellBlur + sigmaMin^2): at 1
-    // a blurred layer is never blurred beyond its true blur's variance. Below 1, a near-focus
-    // layer shares its samples over the grid at the price of up to 1 / sharpShare times its
-    // true blur's variance: for samples that carry their own (noisy) radiance the renderer sets
-    // clamp(sqrt(samples per pixel / 64), 0.5, 1) (reconstructFromLayers; docs/layers.md,
-    // "Near-focus layers share their samples").
+    // The sharp threshold: sharpShare times the grid's own blur with the smallest Gaussian
+    // (kCellBlur + sigmaMin^2). From it on a pixel takes the layer's grid alone: at 1 the grid
+    // never blurs beyond the true blur's variance. Below 1 the grid is taken from a smaller
+    // blur, at the price of up to 1 / sharpShare times its true blur's variance: for samples
+    // that carry their own (noisy) radiance the renderer sets clamp(sqrt(samples per pixel /
+    // 64), 0.5, 1) (reconstructFromLayers; docs/layers.md, "Near-focus layers share their
+    // samples").
     float sharpShare = 1.f;
+    // The sharp band: a pixel takes its own samples of a layer alone (as a sharp layer's) only
+    // while the blur radius of the layer's samples there (the square root of their true blur) is
+    // below sharpBand times the threshold's; from there to the threshold it blends them with the
+    // layer's grid, the grid's share rising linearly with that radius, and from the threshold on
+    // it takes the grid alone. A layer is sharp where all of its pixels take their own samples.
+    // At 1, no band: a layer's sharpness, and with it its noise, stepped at the threshold, tile
+    // by tile and layer by layer (a seam across a ceiling where MC's samples carry their own
+    // noise: docs/layers.md, "A seam where a tile's layer turns sharp"). At 0.5, for filtered
+    // light, relMSE against 1: AAF 0.88-1.006 on nineteen scenes with motion, à-trous 0.84-0.97
+    // on five with a lens (0 cost AAF 10% on docs/posts.json's checkered floor near focus);
+    // where the samples carry their own radiance the renderer sets 0 (MC 0.59-0.91 on the five
+    // lens scenes at 16 and 64 spp; docs/layers.md, "The sharp band").
+    float sharpBand = 0.5f;
     // At most this many layers a tile: past it the split's thresholds widen (x 1.5 until they
     // fit), which merges layers whose visibility then goes unresolved. Consecutive still layers
     // that are each sharp count as one (they composite exactly as one: mergeSharp).
