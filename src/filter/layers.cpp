@@ -415,11 +415,10 @@ struct Layer {
     bool sharp = true;
     bool sharpRun = false;  // several still layers, each sharp, merged into one (splitLayers)
     // A blurred layer some of whose pixels lie in the sharp band (LayerOptions::sharpBand): per
-    // pixel of its tile (row-major from the tile's corner, ownX0 and ownY0, ownW wide), the grid's
-    // share w (sharpWeight of the pixel's mean slope) and, times 1 - w, the alpha and premultiplied
-    // light of the pixel's own samples, as a sharp layer's (Blend). Empty: the grid alone.
+    // pixel of its tile (row-major), the grid's share w (sharpWeight of the pixel's mean slope)
+    // and, times 1 - w, the alpha and premultiplied light of the pixel's own samples, as a sharp
+    // layer's (Blend). Empty: the grid alone.
     std::vector<float> own;
-    int ownX0 = 0, ownY0 = 0, ownW = 0;
     // The Gaussians of the sharp image (layers.h, step 2): sigma for the radiance and the motion,
     // sigmaCoverage (<= sigma) for N, D and the slope, whose grid blur the rays' shear is shaped for.
     float sigma = 0, sigmaCoverage = 0;
@@ -2254,11 +2253,10 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                     const size_t k = size_t(&l - layers.data());
                     if (!l.sharp && !forcedSharp && o.sharpBand < 1.f) {
                         const float nearest = l.cMin <= 0.f && l.cMax >= 0.f ? 0.f : std::min(std::abs(l.cMin), std::abs(l.cMax));
-                        if (trueBlurOf(nearest, motion) < sharpThreshold(o)) {
+                        if (sharpWeight(nearest, motion, o) < 1.f) {
                             twinOf[k] = int(twins.size());
                             Layer& t = twins.emplace_back();
-                            t.c = l.c, t.cMin = l.cMin, t.cMax = l.cMax, t.moving = l.moving, t.depthRate = l.depthRate;
-                            t.invDepthMax = l.invDepthMax, t.invDepthMin = l.invDepthMin;
+                            t.c = l.c, t.moving = l.moving;  // (radianceOf's and resolveCells' reads)
                             t.sharp = true, t.timeBins = 1;
                             t.gx0 = X0, t.gy0 = Y0, t.gw = X1 - X0, t.gh = Y1 - Y0;
                             t.acc.assign(size_t(t.gw) * t.gh * t.accStride(), 0.f);
@@ -2343,6 +2341,17 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                         k = k == -1 ? int16_t(sl) : k == sl ? k : int16_t(-2);
                     }
                 }
+                // What sample s of layer sl carries into layer l (its SplatTarget, or a sharp twin):
+                // radianceOf, and in a sharp layer, on a surface of a textured pixel whose samples
+                // there are all in sl, that pixel's mean albedo x its light.
+                auto splatRadiance = [&](const Gathered& s, int sl, const auto& l) {
+                    if (l.sharp && !surfaceLayer.empty() && s.surface >= 0 && in.surfaceLight[s.surface] && in.surfaceAlbedo[s.surface]) {
+                        const int tp = tilePixel(s);
+                        if (tp >= 0 && surfaceLayer[size_t(tp) * kSurfaces + size_t(s.surface)] == sl)
+                            return (*in.surfaceAlbedo[s.surface])[s.pixel] * (*in.surfaceLight[s.surface])[s.pixel];
+                    }
+                    return radianceOf(s, l);
+                };
                 // (Each sample's layer kept for the D pass of the layers with a motion grid.)
                 std::vector<uint16_t>& sampleLayer = local.sampleLayer;
                 sampleLayer.resize(g.size());
@@ -2377,12 +2386,7 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                         float* m = l.motion + size_t(ci) * 3;
                         m[0] += 1.f, m[1] += s.mx, m[2] += s.my;
                     }
-                    Vec3f radiance = radianceOf(s, l);
-                    if (l.sharp && !surfaceLayer.empty() && s.surface >= 0 && in.surfaceLight[s.surface] && in.surfaceAlbedo[s.surface]) {
-                        const int tp = tilePixel(s);
-                        if (tp >= 0 && surfaceLayer[size_t(tp) * kSurfaces + size_t(s.surface)] == sl)
-                            radiance = (*in.surfaceAlbedo[s.surface])[s.pixel] * (*in.surfaceLight[s.surface])[s.pixel];
-                    }
+                    const Vec3f radiance = splatRadiance(s, sl, l);
                     float* a = cellAcc + 2 + 4 * timeBinOf(l.timeBins, s.t);
                     a[0] += 1.f;
                     a[1] += radiance.x;
@@ -2393,12 +2397,7 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                         Layer& t = twins[size_t(tk)];
                         const int tc = t.cellIndex({s.x, s.y});
                         if (tc < 0) continue;
-                        Vec3f own = radianceOf(s, t);
-                        if (!surfaceLayer.empty() && s.surface >= 0 && in.surfaceLight[s.surface] && in.surfaceAlbedo[s.surface]) {
-                            const int tp = tilePixel(s);
-                            if (tp >= 0 && surfaceLayer[size_t(tp) * kSurfaces + size_t(s.surface)] == sl)
-                                own = (*in.surfaceAlbedo[s.surface])[s.pixel] * (*in.surfaceLight[s.surface])[s.pixel];
-                        }
+                        const Vec3f own = splatRadiance(s, sl, t);
                         float* ta = &t.acc[size_t(tc) * size_t(t.accStride())];
                         ta[0] += 1.f, ta[1] += s.c;
                         ta[2] += 1.f, ta[3] += own.x, ta[4] += own.y, ta[5] += own.z;
@@ -2667,7 +2666,6 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                         Layer& t = twins[size_t(tk)];
                         resolveCells(t, 0.5f, CellBox{0, 0, t.gw, t.gh});
                         const int tcs = t.cellStride();
-                        l.ownX0 = t.gx0, l.ownY0 = t.gy0, l.ownW = t.gw;
                         l.own.resize(size_t(t.gw) * t.gh * 5);
                         for (size_t i = 0; i < size_t(t.gw) * t.gh; ++i) {
                             const float* c = &t.cell[i * size_t(tcs)];
@@ -2742,7 +2740,7 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                             if (!l.own.empty()) {
                                 // In the sharp band: where the grid has no share the pixel's own
                                 // samples alone, as a sharp layer's, else both (Blend).
-                                const float* b = &l.own[(size_t(y - l.ownY0) * size_t(l.ownW) + size_t(x - l.ownX0)) * 5];
+                                const float* b = &l.own[(size_t(y - Y0) * size_t(X1 - X0) + size_t(x - X0)) * 5];
                                 const Blend blend{b[0], b[1], b[2], b[3], b[4]};
                                 if (blend.w == 0.f) {
                                     if (blend.alpha > 0.f) active.push_back({&l, true, {blend.alpha, Vec3f(blend.r, blend.g, blend.b)}, false, blend});
