@@ -1644,7 +1644,7 @@ TEST(Render, MixedPixelsWhoseSurfacesAllMoveTakeFewerTopUps) {
             }
     }
     ASSERT_EQ(stats(0, 0).mixedTopUp(render::kMixedTau, render::kMixedSpp), 48u);
-    const Image<uint32_t> pooled = render::mixedTopUps(stats, render::motionPooling(&lf, {}));
+    const Image<uint32_t> pooled = render::mixedTopUps(stats, render::blurPooling(&lf, view, {}));
     // Pixel 10's trail (pixels 0-20) moves but for pixel 20: tau x 0.5 x 20 x 20 / 21, 8.2
     // samples wanted, already 16.
     EXPECT_EQ(pooled(10, 0), 0u);
@@ -1656,9 +1656,46 @@ TEST(Render, MixedPixelsWhoseSurfacesAllMoveTakeFewerTopUps) {
     EXPECT_LT(pooled(30, 0), 48u);
     Image<uint8_t> bent(W, 1);
     bent(10, 0) = 1;  // a surface turning towards the camera near: aaf and maaf compose it themselves
-    EXPECT_EQ(render::mixedTopUps(stats, render::motionPooling(&lf, bent))(10, 0), 48u);
-    const Image<uint32_t> alone = render::mixedTopUps(stats, render::motionPooling(nullptr, {}));  // --layers off
+    EXPECT_EQ(render::mixedTopUps(stats, render::blurPooling(&lf, view, bent))(10, 0), 48u);
+    const Image<uint32_t> alone = render::mixedTopUps(stats, render::blurPooling(nullptr, view, {}));  // --layers off
     for (int x = 0; x < W; ++x) EXPECT_EQ(alone(x, 0), 48u);
+}
+
+TEST(Render, MixedPixelsWhoseSurfacesAreAllDefocusedTakeFewerTopUps) {
+    // Still pixels with the edge of the tests above (48 more samples wanted at tau alone), their
+    // surface samples at depths whose circles of confusion are 4 px (pixel 0: tau x 0.5 x 16,
+    // 9.8 samples wanted, already 16), 1.71 px (pixel 1: tau x 1.47, 53 wanted), 1 px (pixel 2:
+    // below kDefocusPoolingFrom, no change); in pixel 3 one sample of the 4-px ones is in focus.
+    ViewGeometry view;
+    view.focalPixels = 100;
+    view.apertureRadius = 0.04f;
+    view.focusDistance = 1;
+    ASSERT_NEAR(std::abs(view.defocusSlope(0.5f)), 4.f, 1e-5f);
+    ASSERT_NEAR(std::abs(view.defocusSlope(0.7f)), 1.714f, 1e-3f);
+    ASSERT_NEAR(std::abs(view.defocusSlope(0.8f)), 1.f, 1e-5f);
+    constexpr int W = 4;
+    const float depth[W] = {0.5f, 0.7f, 0.8f, 0.5f};
+    render::PixelStatsImage stats(W, 1);
+    LightFieldSamples lf(W, 1);
+    {
+        render::LightFieldStage record(&lf, [](size_t) { return 16u; });
+        for (int x = 0; x < W; ++x)
+            for (int i = 0; i < 16; ++i) {
+                render::TracedSample s = surfaceSample(i % 2, i % 2 ? 1.f : 0.05f);
+                s.depth = x == 3 && i == 5 ? 1.f : depth[x];
+                record.record(x, 0, s, stats(x, 0).add(s, view, false, stats.pool()));
+            }
+    }
+    for (int x = 0; x < W; ++x) ASSERT_EQ(stats(x, 0).mixedTopUp(render::kMixedTau, render::kMixedSpp), 48u);
+    const Image<uint32_t> pooled = render::mixedTopUps(stats, render::blurPooling(&lf, view, {}));
+    EXPECT_EQ(pooled(0, 0), 0u);
+    EXPECT_GT(pooled(1, 0), 30u);
+    EXPECT_LT(pooled(1, 0), 45u);
+    EXPECT_EQ(pooled(2, 0), 48u);
+    EXPECT_EQ(pooled(3, 0), 48u);
+    Image<uint8_t> bent(W, 1);
+    bent(0, 0) = 1;  // aaf and maaf compose it themselves
+    EXPECT_EQ(render::mixedTopUps(stats, render::blurPooling(&lf, view, bent))(0, 0), 48u);
 }
 
 TEST(Render, PixelStatsTakeFurtherSlotsOnlyForASecondSurface) {

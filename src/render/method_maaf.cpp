@@ -235,7 +235,7 @@ void renderMaaf(const MethodContext& ctx, RenderResult& result) {
     const filter::AafParams rates = filter::aafParams(fb, wedges, view, ao);
     Image<uint32_t> extra(W, H);
     const Image<uint32_t> emitterExtra = emitterTopUps(stats, kEmitterEdgeSpp);
-    const Image<float> pooling = motionPooling(ctx.lightField, bentPixels(ctx), ctx.sampler.distribution());
+    const Image<float> pooling = blurPooling(ctx.lightField, view, bentPixels(ctx), ctx.sampler.distribution());
     const Image<uint32_t> mixedExtra = mixedTopUps(stats, pooling);
     const Image<uint32_t> emitterEdges = emitterTopUps(stats, kEmitterEdgeRays);  // (denseEmission)
     uint64_t extraTotal = 0;

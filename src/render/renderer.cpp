@@ -84,27 +84,33 @@ Image<uint8_t> bentPixels(const MethodContext& ctx) {
     return bent;
 }
 
-Image<float> motionPooling(const LightFieldSamples* lightField, const Image<uint8_t>& bent, const Distribution* distribution) {
+Image<float> blurPooling(const LightFieldSamples* lightField, const ViewGeometry& view, const Image<uint8_t>& bent,
+                         const Distribution* distribution) {
     if (!lightField) return {};
     const int W = lightField->width(), H = lightField->height();
     // Each pixel's slowest surface sample's screen motion (pixels; 0 where none hit a
-    // surface), every rank's rows.
+    // surface), every rank's rows; its surface samples' least circle of confusion (pixels).
     Image<Vec2f> slowest(W, H);
+    Image1f sharpest(W, H);
     parallelRows(H, [&](int y) {
         for (int x = 0; x < W; ++x) {
             int64_t least = -1;
             Vec2f m{0.f, 0.f};
+            float c = kInf;
             lightField->forEach(size_t(y) * W + x, [&](const LightFieldSample& l) {
                 if (!(l.depth < kInf)) return;
+                c = std::min(c, std::abs(view.defocusSlope(l.depth)));
                 const int64_t m2 = int64_t(l.motionX) * l.motionX + int64_t(l.motionY) * l.motionY;
                 if (least >= 0 && m2 >= least) return;
                 least = m2;
                 m = {float(l.motionX) / 8.f, float(l.motionY) / 8.f};
             });
             slowest(x, y) = m;
+            sharpest(x, y) = c < kInf ? c : 0.f;
         }
     });
     exchangeImageRows(distribution, slowest.data(), W, H);
+    exchangeImageRows(distribution, sharpest.data(), W, H);
     Image<float> pooling(W, H);
     parallelRows(H, [&](int y) {
         for (int x = 0; x < W; ++x) {
@@ -125,6 +131,8 @@ Image<float> motionPooling(const LightFieldSamples* lightField, const Image<uint
                 }
                 pooled = std::max(1.f, kMotionPooling * length * float(moving) / float(2 * reach + 1));
             }
+            const float c = sharpest(x, y);
+            if (c >= kDefocusPoolingFrom && (bent.empty() || !bent(x, y))) pooled = std::max(pooled, kDefocusPooling * c * c);
             pooling(x, y) = pooled;
         }
     });
