@@ -14,7 +14,8 @@
 
 namespace wedge::render {
 
-void renderAaf(const MethodContext& ctx, RenderResult& result) {
+void renderAaf(const MethodContext& ctxIn, RenderResult& result) {
+    MethodContext ctx = ctxIn;  // (settleLayers may let the light field go)
     const ViewGeometry& view = ctx.view;
     const int W = view.width, H = view.height;
     const uint32_t n0 = uint32_t(ctx.spp);
@@ -33,6 +34,7 @@ void renderAaf(const MethodContext& ctx, RenderResult& result) {
             [&](int x, int y, const TracedSample& s, int slot) { record.record(x, y, s, slot); }, &progress);
     }
     storeStats(stats, ctx, fb);
+    settleLayers(ctx, stats, result);
     result.seconds.add("sampling_initial", t.seconds());
 
     // 2. Prefilter: fill slopes from neighbours, bandwidths and sampling rates.

@@ -46,7 +46,8 @@ size_t availableMemory() {
 
 }  // namespace
 
-void renderMaaf(const MethodContext& ctx, RenderResult& result) {
+void renderMaaf(const MethodContext& ctxIn, RenderResult& result) {
+    MethodContext ctx = ctxIn;  // (settleLayers may let the light field go)
     const ViewGeometry& view = ctx.view;
     const int W = view.width, H = view.height;
     const uint32_t n0 = uint32_t(ctx.spp);
@@ -160,6 +161,7 @@ void renderMaaf(const MethodContext& ctx, RenderResult& result) {
             &progress);
     }
     storeStats(stats, ctx, fb);
+    settleLayers(ctx, stats, result);
     result.seconds.add("sampling_initial", t.seconds());
 
     // 2a. Prefilter: slopes (AAF's; with --maaf-paper-rates over a 5x5 window, below), frames,

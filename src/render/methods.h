@@ -104,6 +104,12 @@ constexpr float kDefocusPoolingFrom = 1.5f;
 /// every rank reads the other ranks' rows of the trail). Empty without a light field.
 Image<float> blurPooling(const LightFieldSamples* lightField, const ViewGeometry& view, const Image<uint8_t>& bent,
                          const Distribution* distribution = nullptr);
+/// aaf and maaf, after their initial samples (stats, every rank's): where the layers wait for
+/// them (RenderOptions::layeredIfMixed) and fewer than kLayersMixedShare of the pixels saw
+/// several surfaces, the light field is let go and ctx.lightField set to null: the render is
+/// the one `--layers off` gives, to the bit. Adds `layers_mixed_share` to the result's figures
+/// where it decided.
+void settleLayers(MethodContext& ctx, const PixelStatsImage& stats, RenderResult& result);
 /// The mixed pixels' top-ups of aaf and maaf: PixelStats::mixedTopUp at kMixedTau times the
 /// pixel's `pooling` (blurPooling; empty: 1), up to kMixedSpp.
 Image<uint32_t> mixedTopUps(const PixelStatsImage& stats, const Image<float>& pooling);

@@ -139,6 +139,18 @@ Image<float> blurPooling(const LightFieldSamples* lightField, const ViewGeometry
     return pooling;
 }
 
+void settleLayers(MethodContext& ctx, const PixelStatsImage& stats, RenderResult& result) {
+    if (!ctx.lightField || !ctx.options.layeredIfMixed(ctx.spp, ctx.scene.desc().hasMotion())) return;
+    const size_t pixels = size_t(stats.width()) * stats.height();
+    size_t mixed = 0;
+    for (size_t p = 0; p < pixels; ++p) mixed += stats[p].mixed();
+    const double share = double(mixed) / double(std::max<size_t>(1, pixels));
+    result.extra.emplace_back("layers_mixed_share", share);
+    if (share >= RenderOptions::kLayersMixedShare) return;
+    *ctx.lightField = LightFieldSamples();
+    ctx.lightField = nullptr;
+}
+
 Image<uint32_t> mixedTopUps(const PixelStatsImage& stats, const Image<float>& pooling) {
     const int W = stats.width(), H = stats.height();
     Image<uint32_t> extra(W, H);
@@ -458,7 +470,7 @@ bool keepsSags(const scene::SceneDesc& desc) {
 }
 
 bool keepsLightField(const scene::SceneDesc& desc, const RenderOptions& options, int spp) {
-    return options.layered(spp, desc.hasMotion()) && (desc.camera.apertureRadius > 0 || desc.hasMotion());
+    return options.layered(spp) && (desc.camera.apertureRadius > 0 || desc.hasMotion());
 }
 
 RenderResult render(const scene::Scene& scene, const RenderOptions& options) {

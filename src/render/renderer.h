@@ -73,8 +73,11 @@ struct RenderOptions {
     // kLayersAutoSpp samples per pixel: on for mc and atrous; for aaf and maaf on where the
     // scene moves (their filters have none over the shutter: a motion-blurred silhouette kept
     // its samples' noise, and AAF without layers measured 0.77-0.87x MC's efficiency on
-    // docs/bunny-motion.json) and off where only the lens blurs (their own defocus filter is the
-    // more efficient there). docs/layers.md, "`auto` for the filters where the scene moves".
+    // docs/bunny-motion.json), and where only the lens blurs, on where at least
+    // kLayersMixedShare of the pixels' initial samples saw several surfaces (layeredIfMixed):
+    // the layers gain at defocused silhouettes, and cost the same wherever the image has few.
+    // docs/layers.md, "`auto` for the filters where the scene moves" and "... and where
+    // defocused silhouettes are many".
     std::string layers = "auto";
     /// Several ranks rendering one image together (render/distribution.h; the command line's
     /// MPI ranks): every rank calls render() with the same options and gets the same result
@@ -85,12 +88,20 @@ struct RenderOptions {
     /// (16-64), and where the samples it keeps (24 bytes each) fit: a 4096-spp reference at
     /// 512x512 would keep 26 GB and take the stage minutes for what plain Monte Carlo already has.
     static constexpr int kLayersAutoSpp = 64;
-    /// Whether `method` at `spp` samples per pixel reconstructs with layers under this setting,
-    /// in a scene that moves or not.
-    bool layered(int spp, bool sceneMoves) const {
-        if (layers == "on") return true;
-        if (layers != "auto" || spp > kLayersAutoSpp) return false;
-        return method == "mc" || method == "atrous" || sceneMoves;
+    /// aaf and maaf under `auto` where only the lens blurs reconstruct with layers where at
+    /// least this share of the pixels saw several surfaces in their initial samples (a lens-only
+    /// scene has 2-6% (cornell, bunny, cornell-sphere, docs/textured.json) or 22-52% (conference,
+    /// sponza, docs/conference-wide.json, docs/bunny-near.json)).
+    static constexpr float kLayersMixedShare = 0.15f;
+    /// Whether a method at `spp` samples per pixel may reconstruct with layers under this
+    /// setting: whether it keeps the light field, at least through its initial samples
+    /// (layeredIfMixed).
+    bool layered(int spp) const { return layers == "on" || (layers == "auto" && spp <= kLayersAutoSpp); }
+    /// Whether that waits for the initial samples: aaf and maaf under `auto` where nothing moves
+    /// reconstruct with layers only where at least kLayersMixedShare of the pixels saw several
+    /// surfaces (render/methods.h, settleLayers).
+    bool layeredIfMixed(int spp, bool sceneMoves) const {
+        return layers == "auto" && spp <= kLayersAutoSpp && (method == "aaf" || method == "maaf") && !sceneMoves;
     }
 };
 
