@@ -75,7 +75,8 @@ struct RenderOptions {
     // its samples' noise, and AAF without layers measured 0.77-0.87x MC's efficiency on
     // docs/bunny-motion.json), and where only the lens blurs, on where at least
     // kLayersMixedShare of the pixels' initial samples saw several surfaces (layeredIfMixed):
-    // the layers gain at defocused silhouettes, and cost the same wherever the image has few.
+    // the layers gain at defocused silhouettes and, where the image has few, cost more than
+    // they gain.
     // docs/layers.md, "`auto` for the filters where the scene moves" and "... and where
     // defocused silhouettes are many".
     std::string layers = "auto";
