@@ -818,7 +818,7 @@ TEST(Layers, AutoReconstructsForMonteCarloAndAtrousAndForTheFiltersWhereTheScene
             // (AutoWaitsForTheFiltersInitialSamplesWhereOnlyTheLensBlurs; here, at 4 spp, 11% of
             // the pixels saw the edge and the background, and they do not).
             const bool filter = std::string(method) == "aaf" || std::string(method) == "maaf";
-            const std::optional<double> share = r.figure("layers_mixed_share");
+            const std::optional<double> share = r.figure("layers_defocused_mixed_share");
             EXPECT_EQ(share.has_value(), filter && !moves) << method;
             const bool expected = !filter || moves || (share && *share >= render::RenderOptions::kLayersMixedShare);
             EXPECT_EQ(r.figure("layers_sample_bytes").has_value(), expected) << method << (moves ? ", moving" : ", still");
@@ -849,37 +849,60 @@ TEST(Layers, AutoReconstructsForMonteCarloAndAtrousAndForTheFiltersWhereTheScene
 }
 
 TEST(Layers, AutoWaitsForTheFiltersInitialSamplesWhereOnlyTheLensBlurs) {
-    // kDefocusedEdge's half-plane near the focal plane (depth 3.8 of 4): a narrow band of mixed
-    // pixels, below kLayersMixedShare, so aaf and maaf let the light field go after their initial
-    // samples and give --layers off's image to the bit; at depth 1 (a circle of confusion of 26
-    // px: the band half the image wide) they reconstruct with layers.
+    // kDefocusedEdge's half-plane nearer the focal plane (depth 3.2 of 4: a circle of confusion
+    // of 2.1 px): a narrow band of defocused mixed pixels, below kLayersMixedShare, so aaf and
+    // maaf let the light field go after their initial samples and give --layers off's image to
+    // the bit; at depth 1 (a circle of 26 px: the band half the image wide) they reconstruct with
+    // layers. Mixed pixels in focus do not count (the strips below).
     std::string nearFocus = kDefocusedEdge, far = kDefocusedEdge;
-    nearFocus.replace(nearFocus.find("-10, -10, -2]"), 13, "-10, -10, -3.8]");
+    nearFocus.replace(nearFocus.find("-10, -10, -2]"), 13, "-10, -10, -3.2]");
     far.replace(far.find("-10, -10, -2]"), 13, "-10, -10, -1]");
     for (const char* method : {"aaf", "maaf"}) {
         render::RenderOptions o;
         o.method = method;
         o.spp = 8;
         const render::RenderResult autoFar = renderJson(far, o);
-        ASSERT_TRUE(autoFar.figure("layers_mixed_share").has_value()) << method;
-        EXPECT_GT(*autoFar.figure("layers_mixed_share"), 0.3) << method;
+        ASSERT_TRUE(autoFar.figure("layers_defocused_mixed_share").has_value()) << method;
+        EXPECT_GT(*autoFar.figure("layers_defocused_mixed_share"), 0.3) << method;
         EXPECT_TRUE(autoFar.figure("layers_sample_bytes").has_value()) << method;
         const render::RenderResult autoNear = renderJson(nearFocus, o);
-        ASSERT_TRUE(autoNear.figure("layers_mixed_share").has_value()) << method;
-        EXPECT_GT(*autoNear.figure("layers_mixed_share"), 0.0) << method;
-        EXPECT_LT(*autoNear.figure("layers_mixed_share"), render::RenderOptions::kLayersMixedShare) << method;
+        ASSERT_TRUE(autoNear.figure("layers_defocused_mixed_share").has_value()) << method;
+        EXPECT_GT(*autoNear.figure("layers_defocused_mixed_share"), 0.0) << method;
+        EXPECT_LT(*autoNear.figure("layers_defocused_mixed_share"), render::RenderOptions::kLayersMixedShare) << method;
         EXPECT_FALSE(autoNear.figure("layers_sample_bytes").has_value()) << method;
         o.layers = "off";
         const render::RenderResult offNear = renderJson(nearFocus, o);
-        EXPECT_FALSE(offNear.figure("layers_mixed_share").has_value()) << method;
+        EXPECT_FALSE(offNear.figure("layers_defocused_mixed_share").has_value()) << method;
         ASSERT_EQ(autoNear.color.size(), offNear.color.size());
         for (size_t i = 0; i < offNear.color.size(); ++i)
             ASSERT_EQ(autoNear.color[i], offNear.color[i]) << method << " pixel " << i;
         o.layers = "on";  // the choice is auto's alone
         const render::RenderResult onNear = renderJson(nearFocus, o);
-        EXPECT_FALSE(onNear.figure("layers_mixed_share").has_value()) << method;
+        EXPECT_FALSE(onNear.figure("layers_defocused_mixed_share").has_value()) << method;
         EXPECT_TRUE(onNear.figure("layers_sample_bytes").has_value()) << method;
     }
+    // Strips 1.5 px wide every 3 px at the focal distance, nothing behind them: nearly every
+    // pixel sees a strip and the background, but in focus, where a layer keeps its pixels' own
+    // samples: no layers.
+    std::string strips = kDefocusedEdge;
+    std::string objects;
+    const float pixel = 4.f * std::tan(10.f * float(M_PI) / 180.f) / 12.f;  // world size of a pixel at depth 4
+    for (int k = -17; k <= 17; ++k)
+        objects += std::string(objects.empty() ? "" : ", ") + "{\"type\": \"quad\", \"corner\": [" +
+                   std::to_string(3.f * pixel * float(k)) + ", -2, -4], \"edge1\": [" + std::to_string(1.5f * pixel) +
+                   ", 0, 0], \"edge2\": [0, 4, 0], \"material\": \"white\"}";
+    const size_t from = strips.find("\"objects\": ["), to = strips.find("}]", from) + 2;
+    strips.replace(from, to - from, "\"objects\": [" + objects + "]");
+    render::RenderOptions o;
+    o.method = "aaf";
+    o.spp = 8;
+    const render::RenderResult r = renderJson(strips, o);
+    ASSERT_TRUE(r.figure("layers_defocused_mixed_share").has_value());
+    EXPECT_LT(*r.figure("layers_defocused_mixed_share"), 0.01);
+    EXPECT_FALSE(r.figure("layers_sample_bytes").has_value());
+    size_t mixed = 0;
+    for (size_t p = 0; p < r.buffers.coverage.size(); ++p) mixed += r.buffers.coverage[p] < 0.99f;
+    EXPECT_GT(double(mixed) / double(r.buffers.coverage.size()), 0.5) << "the strips should mix most pixels";
 }
 
 TEST(Layers, ConsecutiveSharpLayersMergeAndTheImageStaysTheSame) {

@@ -1665,7 +1665,7 @@ TEST(Render, MixedPixelsWhoseSurfacesAreAllDefocusedTakeFewerTopUps) {
     // Still pixels with the edge of the tests above (48 more samples wanted at tau alone), their
     // surface samples at depths whose circles of confusion are 4 px (pixel 0: tau x 0.5 x 16,
     // 9.8 samples wanted, already 16), 1.71 px (pixel 1: tau x 1.47, 53 wanted), 1 px (pixel 2:
-    // below kDefocusPoolingFrom, no change); in pixel 3 one sample of the 4-px ones is in focus.
+    // below kLayerBlurFrom, no change); in pixel 3 one sample of the 4-px ones is in focus.
     ViewGeometry view;
     view.focalPixels = 100;
     view.apertureRadius = 0.04f;

@@ -87,17 +87,20 @@ constexpr uint32_t kMixedSpp = 64;
 /// measured 1.08x and 1.09x against 1.125x on eight of them (docs/layers.md, "Fewer top-ups
 /// where every surface moves").
 constexpr float kMotionPooling = 0.5f;
+/// The circle of confusion (radius, pixels) from which the layers reconstruct a surface from its
+/// neighbours' samples as well as its own: a layer blurred by less, below the layers' sharp
+/// threshold of 1.41 px, keeps its pixels' own samples. Where the mixed pixels' top-ups pool
+/// (blurPooling) and what settleLayers counts.
+constexpr float kLayerBlurFrom = 1.5f;
 /// Likewise a mixed pixel whose every surface sample is defocused, by a circle of confusion of
-/// radius c pixels (|defocus slope|) at least kDefocusPoolingFrom: the layers reconstruct it
-/// from the samples of the pixels its circle covers (a layer blurred by less, below the layers'
-/// sharp threshold of 1.41 px, keeps its pixels' own samples), and tau is multiplied by
-/// kDefocusPooling x c^2 (the circle's area over 2 pi, as the motion's half a pixel per pixel
-/// crossed). AAF with layers, against the same without this (docs/layers.md, "Fewer top-ups
-/// where every surface is defocused"): sponza-motion 42.4 -> 35.9 samples a pixel for relMSE
-/// +0.9%, sponza (--layers on) 41.9 -> 35.4 for +0.9%; fence, bunny-slats 5-6% fewer for +0.4%;
-/// elsewhere within 2% of the samples (fast-motion 1% fewer for +1.7%, the one loss).
+/// radius c pixels (|defocus slope|) at least kLayerBlurFrom: the layers reconstruct it from the
+/// samples of the pixels its circle covers, and tau is multiplied by kDefocusPooling x c^2 (the
+/// circle's area over 2 pi, as the motion's half a pixel per pixel crossed). AAF with layers,
+/// against the same without this (docs/layers.md, "Fewer top-ups where every surface is
+/// defocused"): sponza-motion 42.4 -> 35.9 samples a pixel for relMSE +0.9%, sponza (--layers
+/// on) 41.9 -> 35.4 for +0.9%; fence, bunny-slats 5-6% fewer for +0.4%; elsewhere within 2% of
+/// the samples (fast-motion 1% fewer for +1.7%, the one loss).
 constexpr float kDefocusPooling = 0.5f;
-constexpr float kDefocusPoolingFrom = 1.5f;
 /// Per pixel, the factor kMotionPooling or kDefocusPooling gives its top-up's tau (the larger; 1
 /// where neither gives any), from the light field's initial samples: not in the pixels `bent`
 /// marks (bentPixels; may be empty), which aaf and maaf compose themselves (`distribution`:
@@ -106,9 +109,9 @@ Image<float> blurPooling(const LightFieldSamples* lightField, const ViewGeometry
                          const Distribution* distribution = nullptr);
 /// aaf and maaf, after their initial samples (stats, every rank's): where the layers wait for
 /// them (RenderOptions::layeredIfMixed) and fewer than kLayersMixedShare of the pixels saw
-/// several surfaces, the light field is let go and ctx.lightField set to null: the render is
-/// the one `--layers off` gives, to the bit. Adds `layers_mixed_share` to the result's figures
-/// where it decided.
+/// several surfaces, one of them defocused by at least kLayerBlurFrom, the light field is let
+/// go and ctx.lightField set to null: the render is the one `--layers off` gives, to the bit.
+/// Adds `layers_defocused_mixed_share` to the result's figures where it decided.
 void settleLayers(MethodContext& ctx, const PixelStatsImage& stats, RenderResult& result);
 /// The mixed pixels' top-ups of aaf and maaf: PixelStats::mixedTopUp at kMixedTau times the
 /// pixel's `pooling` (blurPooling; empty: 1), up to kMixedSpp.

@@ -132,7 +132,7 @@ Image<float> blurPooling(const LightFieldSamples* lightField, const ViewGeometry
                 pooled = std::max(1.f, kMotionPooling * length * float(moving) / float(2 * reach + 1));
             }
             const float c = sharpest(x, y);
-            if (c >= kDefocusPoolingFrom && (bent.empty() || !bent(x, y))) pooled = std::max(pooled, kDefocusPooling * c * c);
+            if (c >= kLayerBlurFrom && (bent.empty() || !bent(x, y))) pooled = std::max(pooled, kDefocusPooling * c * c);
             pooling(x, y) = pooled;
         }
     });
@@ -141,11 +141,27 @@ Image<float> blurPooling(const LightFieldSamples* lightField, const ViewGeometry
 
 void settleLayers(MethodContext& ctx, const PixelStatsImage& stats, RenderResult& result) {
     if (!ctx.lightField || !ctx.options.layeredIfMixed(ctx.spp, ctx.scene.desc().hasMotion())) return;
-    const size_t pixels = size_t(stats.width()) * stats.height();
-    size_t mixed = 0;
-    for (size_t p = 0; p < pixels; ++p) mixed += stats[p].mixed();
-    const double share = double(mixed) / double(std::max<size_t>(1, pixels));
-    result.extra.emplace_back("layers_mixed_share", share);
+    // The mixed pixels with a surface sample blurred by at least kLayerBlurFrom: those the
+    // layers reconstruct from their neighbours' samples (an in-focus edge's keep their own).
+    const LightFieldSamples& lf = *ctx.lightField;
+    const int W = stats.width(), H = stats.height();
+    std::vector<uint32_t> rows(size_t(H), 0);
+    parallelRows(H, [&](int y) {
+        if (!ctx.sampler.tracesRow(y)) return;  // (another rank's: below)
+        for (size_t p = size_t(y) * W; p < size_t(y + 1) * W; ++p) {
+            if (!stats[p].mixed()) continue;
+            bool blurred = false;
+            lf.forEach(p, [&](const LightFieldSample& l) {
+                blurred |= l.depth < kInf && std::abs(ctx.view.defocusSlope(l.depth)) >= kLayerBlurFrom;
+            });
+            rows[size_t(y)] += blurred;
+        }
+    });
+    // Every rank's rows (each rank holds the samples of its own rows only).
+    exchangeImageRows(ctx.sampler.distribution(), rows.data(), 1, H);
+    const size_t pixels = size_t(W) * H;
+    const double share = double(std::accumulate(rows.begin(), rows.end(), uint64_t{0})) / double(std::max<size_t>(1, pixels));
+    result.extra.emplace_back("layers_defocused_mixed_share", share);
     if (share >= RenderOptions::kLayersMixedShare) return;
     *ctx.lightField = LightFieldSamples();
     ctx.lightField = nullptr;

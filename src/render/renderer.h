@@ -74,7 +74,8 @@ struct RenderOptions {
     // scene moves (their filters have none over the shutter: a motion-blurred silhouette kept
     // its samples' noise, and AAF without layers measured 0.77-0.87x MC's efficiency on
     // docs/bunny-motion.json), and where only the lens blurs, on where at least
-    // kLayersMixedShare of the pixels' initial samples saw several surfaces (layeredIfMixed):
+    // kLayersMixedShare of the pixels' initial samples saw several surfaces, one of them
+    // defocused (layeredIfMixed):
     // the layers gain at defocused silhouettes and, where the image has few, cost more than
     // they gain.
     // docs/layers.md, "`auto` for the filters where the scene moves" and "... and where
@@ -90,9 +91,12 @@ struct RenderOptions {
     /// 512x512 would keep 26 GB and take the stage minutes for what plain Monte Carlo already has.
     static constexpr int kLayersAutoSpp = 64;
     /// aaf and maaf under `auto` where only the lens blurs reconstruct with layers where at
-    /// least this share of the pixels saw several surfaces in their initial samples (a lens-only
-    /// scene has 2-6% (cornell, bunny, cornell-sphere, docs/textured.json) or 22-52% (conference,
-    /// sponza, docs/conference-wide.json, docs/bunny-near.json)).
+    /// least this share of the pixels saw several surfaces in their initial samples, one of
+    /// them defocused by a circle of at least 1.5 px (kLayerBlurFrom): 0-6% on cornell, bunny,
+    /// cornell-sphere, docs/textured.json and conference at 256x256 (its mixed pixels there
+    /// in-focus edges), 20-43% on conference and sponza at 512x512, docs/conference-wide.json
+    /// and docs/bunny-near.json. docs/layers.md, "`auto` for the filters where defocused
+    /// silhouettes are many".
     static constexpr float kLayersMixedShare = 0.15f;
     /// Whether a method at `spp` samples per pixel may reconstruct with layers under this
     /// setting: whether it keeps the light field, at least through its initial samples
@@ -100,7 +104,7 @@ struct RenderOptions {
     bool layered(int spp) const { return layers == "on" || (layers == "auto" && spp <= kLayersAutoSpp); }
     /// Whether that waits for the initial samples: aaf and maaf under `auto` where nothing moves
     /// reconstruct with layers only where at least kLayersMixedShare of the pixels saw several
-    /// surfaces (render/methods.h, settleLayers).
+    /// surfaces, one of them defocused (render/methods.h, settleLayers).
     bool layeredIfMixed(int spp, bool sceneMoves) const {
         return layers == "auto" && spp <= kLayersAutoSpp && (method == "aaf" || method == "maaf") && !sceneMoves;
     }
