@@ -84,7 +84,7 @@ void addMethodFlags(CLI::App& cmd, render::RenderOptions& r) {
         ->check(CLI::IsMember({"sobol", "independent"}));
     cmd.add_option("--layers", r.layers,
                    "auto (default: up to 64 spp on for mc and atrous, and for aaf and maaf where the scene moves or at least 15% of the "
-                   "pixels' initial samples saw several surfaces), on: the layered reconstruction of "
+                   "pixels' initial samples saw several surfaces, one defocused), on: the layered reconstruction of "
                    "defocus and motion blur across pixels, off: each pixel's own samples (and aaf's and maaf's defocus filter)")
         ->check(CLI::IsMember({"auto", "on", "off"}));
 }
