@@ -93,9 +93,9 @@ struct RenderOptions {
     /// aaf and maaf under `auto` where only the lens blurs reconstruct with layers where at
     /// least this share of the pixels saw several surfaces in their initial samples, one of
     /// them defocused by a circle of at least 1.5 px (kLayerBlurFrom): 0-6% on cornell, bunny,
-    /// cornell-sphere, docs/textured.json and conference at 256x256 (its mixed pixels there
-    /// in-focus edges), 20-43% on conference and sponza at 512x512, docs/conference-wide.json
-    /// and docs/bunny-near.json. docs/layers.md, "`auto` for the filters where defocused
+    /// cornell-sphere, docs/textured.json and conference at 256x256 with a smaller lens (its
+    /// mixed pixels there in-focus edges), 20-43% on conference and sponza at 512x512,
+    /// docs/conference-wide.json and docs/bunny-near.json. docs/layers.md, "`auto` for the filters where defocused
     /// silhouettes are many".
     static constexpr float kLayersMixedShare = 0.15f;
     /// Whether a method at `spp` samples per pixel may reconstruct with layers under this
