@@ -246,6 +246,18 @@ inline bool curved(const Gathered& s) { return s.sx != 0.f || s.sy != 0.f; }
 
 /// The time bin of shutter time t among `bins`.
 inline int timeBinOf(int bins, float t) { return std::min(bins - 1, int(t * float(bins))); }
+/// A sample into its cell of a layer's accumulation (Layer::acc: N, the sum of the slopes, then
+/// per time bin W and the radiance) and the cell's D: for its own layer and for a sharp twin alike.
+inline void splatCell(float* cellAcc, float& d, float c, int bin, const Vec3f& radiance) {
+    cellAcc[0] += 1.f;
+    cellAcc[1] += c;
+    d += 1.f;
+    float* a = cellAcc + 2 + 4 * bin;
+    a[0] += 1.f;
+    a[1] += radiance.x;
+    a[2] += radiance.y;
+    a[3] += radiance.z;
+}
 
 /// The least-squares affine fit m(p) = mean + B (p - centre) of a moving layer's samples' screen
 /// motion to their positions in its sharp image. An object moving in depth grows or shrinks on
@@ -2378,30 +2390,16 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                         sa[size_t(ci) * 2] += e.x;
                         sa[size_t(ci) * 2 + 1] += e.y;
                     }
-                    float* cellAcc = l.acc + size_t(ci) * l.accStride;
-                    cellAcc[0] += 1.f;
-                    l.d[ci] += 1.f;
-                    cellAcc[1] += s.c;
                     if (l.motion) {
                         float* m = l.motion + size_t(ci) * 3;
                         m[0] += 1.f, m[1] += s.mx, m[2] += s.my;
                     }
-                    const Vec3f radiance = splatRadiance(s, sl, l);
-                    float* a = cellAcc + 2 + 4 * timeBinOf(l.timeBins, s.t);
-                    a[0] += 1.f;
-                    a[1] += radiance.x;
-                    a[2] += radiance.y;
-                    a[3] += radiance.z;
+                    splatCell(l.acc + size_t(ci) * l.accStride, l.d[ci], s.c, timeBinOf(l.timeBins, s.t), splatRadiance(s, sl, l));
                     if (const int tk = twinOf[size_t(sl)]; tk >= 0) {
                         // Its layer's twin: as a sharp layer takes it, at its own position.
                         Layer& t = twins[size_t(tk)];
                         const int tc = t.cellIndex({s.x, s.y});
-                        if (tc < 0) continue;
-                        const Vec3f own = splatRadiance(s, sl, t);
-                        float* ta = &t.acc[size_t(tc) * size_t(t.accStride())];
-                        ta[0] += 1.f, ta[1] += s.c;
-                        ta[2] += 1.f, ta[3] += own.x, ta[4] += own.y, ta[5] += own.z;
-                        t.accD[size_t(tc)] += 1.f;
+                        if (tc >= 0) splatCell(&t.acc[size_t(tc) * size_t(t.accStride())], t.accD[size_t(tc)], s.c, 0, splatRadiance(s, sl, t));
                     }
                 }
                 // D of the layers in front of a sample, at their shear (as Layer::sharpPosition):

@@ -75,11 +75,9 @@ struct RenderOptions {
     // its samples' noise, and AAF without layers measured 0.77-0.87x MC's efficiency on
     // docs/bunny-motion.json), and where only the lens blurs, on where at least
     // kLayersMixedShare of the pixels' initial samples saw several surfaces, one of them
-    // defocused (layeredIfMixed):
-    // the layers gain at defocused silhouettes and, where the image has few, cost more than
-    // they gain.
-    // docs/layers.md, "`auto` for the filters where the scene moves" and "... and where
-    // defocused silhouettes are many".
+    // defocused (layeredIfMixed): the layers gain at defocused silhouettes and, where the image
+    // has few, cost more than they gain. docs/layers.md, "`auto` for the filters where the
+    // scene moves" and "... and where defocused silhouettes are many".
     std::string layers = "auto";
     /// Several ranks rendering one image together (render/distribution.h; the command line's
     /// MPI ranks): every rank calls render() with the same options and gets the same result
@@ -95,8 +93,8 @@ struct RenderOptions {
     /// them defocused by a circle of at least 1.5 px (kLayerBlurFrom): 0-6% on cornell, bunny,
     /// cornell-sphere, docs/textured.json and conference at 256x256 with a smaller lens (its
     /// mixed pixels there in-focus edges), 20-43% on conference and sponza at 512x512,
-    /// docs/conference-wide.json and docs/bunny-near.json. docs/layers.md, "`auto` for the filters where defocused
-    /// silhouettes are many".
+    /// docs/conference-wide.json and docs/bunny-near.json. docs/layers.md, "`auto` for the
+    /// filters where defocused silhouettes are many".
     static constexpr float kLayersMixedShare = 0.15f;
     /// Whether a method at `spp` samples per pixel may reconstruct with layers under this
     /// setting: whether it keeps the light field, at least through its initial samples
@@ -106,7 +104,7 @@ struct RenderOptions {
     /// reconstruct with layers only where at least kLayersMixedShare of the pixels saw several
     /// surfaces, one of them defocused (render/methods.h, settleLayers).
     bool layeredIfMixed(int spp, bool sceneMoves) const {
-        return layers == "auto" && spp <= kLayersAutoSpp && (method == "aaf" || method == "maaf") && !sceneMoves;
+        return layers == "auto" && layered(spp) && (method == "aaf" || method == "maaf") && !sceneMoves;
     }
 };
 
