@@ -80,5 +80,5 @@ for m in ("aaf", "maaf"):
     first = med(r["seconds"]["sampling_initial"] for r in st)
     print(f"  wedge {m}: total {total:.2f} s (sampling {med(r['seconds']['sampling'] for r in st):.2f} s, "
           f"{st[0]['spp_average']:.1f} spp); total / pathtracer frame {total / fa:.2f} (ambient), {total / fp:.2f} (point)")
-    print(f"    its first 16 spp (with the occluder spans): {first:.2f} s, {first / fa:.2f} / {first / fp:.2f} of the frames")
+    print(f"    its first 16 spp (with the slopes' occluder queries): {first:.2f} s, {first / fa:.2f} / {first / fp:.2f} of the frames")
 PY

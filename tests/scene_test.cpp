@@ -32,12 +32,6 @@ SceneDesc oneQuad() {
     return d;
 }
 
-void expectSpan(const OccluderSpan& span, float tNear, float tFar) {
-    ASSERT_TRUE(span.occluded);
-    EXPECT_NEAR(span.tNear, tNear, 1e-4f);
-    EXPECT_NEAR(span.tFar, tFar, 1e-4f);
-}
-
 }  // namespace
 
 TEST(Scene, TriangleNormalIsCounterClockwise) {
@@ -202,32 +196,24 @@ TEST(Scene, SphereLightIrradianceMatchesTheConeItFills) {
     EXPECT_EQ(unoccludedIrradiance({sphere}, sphere.corner + Vec3f(0.1f, 0, 0), {0, 1, 0}).x, 0.f) << "inside";
 }
 
-TEST(Scene, OccluderSpanFindsNearestAndFarthest) {
-    SceneDesc d = oneQuad();
-    TriangleMesh m;
-    appendQuad(m, {-1, -1, 1}, {2, 0, 0}, {0, 2, 0}, 0);
-    appendQuad(m, {-1, -1, 2.5f}, {2, 0, 0}, {0, 2, 0}, 0);
-    d.meshes.push_back(m);
-    Scene s(std::move(d));
-    expectSpan(s.occluders({0, 0, 0.01f}, {0, 0, 1}, 0, 10, 0), 0.99f, 2.49f);
-    EXPECT_TRUE(s.occluded({0, 0, 0.01f}, {0, 0, 1}, 0, 10, 0));
-    EXPECT_FALSE(s.occluded({0, 0, 0.01f}, {0, 0, 1}, 0, 0.5f, 0));
-    EXPECT_FALSE(s.occluders({0, 0, 0.01f}, {0, 0, 1}, 0, 0.5f, 0).occluded);
-}
-
-TEST(Scene, OccluderSpanOfManyAndOfOneOccluder) {
-    // The span is found by two closest-hit queries (from each end): the middle occluder must not
-    // matter, and a single occluder gives tNear == tFar. Offsetting the segment's start shifts both.
+TEST(Scene, NearestOccluderIsTheFirstAlongTheSegment) {
+    // Three occluders stacked over the origin, one more only over x in [5, 7]: the shadow
+    // slopes take the one nearest the receiver, measured from the segment's origin whatever
+    // its tNear, and none beyond its end.
     SceneDesc d = oneQuad();
     TriangleMesh m;
     for (float z : {1.f, 1.7f, 2.5f}) appendQuad(m, {-1, -1, z}, {2, 0, 0}, {0, 2, 0}, 0);
-    appendQuad(m, {5, -1, 1.2f}, {2, 0, 0}, {0, 2, 0}, 0);  // only under x in [5, 7]
+    appendQuad(m, {5, -1, 1.2f}, {2, 0, 0}, {0, 2, 0}, 0);
     d.meshes.push_back(m);
     Scene s(std::move(d));
-    expectSpan(s.occluders({0, 0, 0}, {0, 0, 1}, 0.5f, 3.f, 0), 1.f, 2.5f);
-    expectSpan(s.occluders({6, 0, 0}, {0, 0, 1}, 0.f, 3.f, 0), 1.2f, 1.2f);
-    // A segment ending between the occluders sees only those before its end.
-    expectSpan(s.occluders({0, 0, 0}, {0, 0, 1}, 0.f, 2.f, 0), 1.f, 1.7f);
+    EXPECT_NEAR(s.nearestOccluder({0, 0, 0.01f}, {0, 0, 1}, 0, 10, 0), 0.99f, 1e-4f);
+    EXPECT_NEAR(s.nearestOccluder({0, 0, 0}, {0, 0, 1}, 0.5f, 3.f, 0), 1.f, 1e-4f);
+    EXPECT_NEAR(s.nearestOccluder({0, 0, 0}, {0, 0, 1}, 1.2f, 3.f, 0), 1.7f, 1e-4f);  // past the first
+    EXPECT_NEAR(s.nearestOccluder({6, 0, 0}, {0, 0, 1}, 0.f, 3.f, 0), 1.2f, 1e-4f);
+    EXPECT_TRUE(s.occluded({0, 0, 0.01f}, {0, 0, 1}, 0, 10, 0));
+    EXPECT_FALSE(s.occluded({0, 0, 0.01f}, {0, 0, 1}, 0, 0.5f, 0));
+    EXPECT_EQ(s.nearestOccluder({0, 0, 0.01f}, {0, 0, 1}, 0, 0.5f, 0), kInf);
+    EXPECT_EQ(s.nearestOccluder({3, 0, 0.01f}, {0, 0, 1}, 0, 10, 0), kInf);  // beside them all
 }
 
 TEST(Scene, StreamQueriesAreTheSingleRayQueries) {
@@ -251,36 +237,33 @@ TEST(Scene, StreamQueriesAreTheSingleRayQueries) {
     const size_t n = rays.size();
     std::vector<Hit> hits(n);
     std::vector<char> found(n), occ(n);
-    std::vector<OccluderSpan> spans(n);
-    int hitCount = 0, spanCount = 0;
+    std::vector<float> nearest(n);
+    int hitCount = 0;
     for (size_t i = 0; i < n; ++i) {
         found[i] = s.intersect(rays[i].org, rays[i].dir, 0.f, rays[i].tFar, 0.f, hits[i]);
         occ[i] = s.occluded(rays[i].org, rays[i].dir, 0.f, rays[i].tFar, 0.f);
-        spans[i] = s.occluders(rays[i].org, rays[i].dir, 0.f, rays[i].tFar, 0.f);
+        nearest[i] = s.nearestOccluder(rays[i].org, rays[i].dir, 0.f, rays[i].tFar, 0.f);
         hitCount += found[i];
-        spanCount += spans[i].occluded && spans[i].tFar > spans[i].tNear;
+        // The same closest hit as intersect's, without its hit record.
+        EXPECT_EQ(nearest[i], found[i] ? hits[i].t : kInf) << i;
+        EXPECT_EQ(nearest[i] < kInf, bool(occ[i])) << i;
     }
     ASSERT_GT(hitCount, 100);
     ASSERT_LT(hitCount, 650);
-    ASSERT_GT(spanCount, 20);  // rays that pass several quads
     for (size_t chunk : {size_t(1), size_t(13), size_t(256), n}) {
         std::vector<Hit> h(n);
         bool f[700], o[700];
-        std::vector<OccluderSpan> sp(n);
+        std::vector<float> t(n);
         for (size_t b = 0; b < n; b += chunk) {
             const size_t c = std::min(chunk, n - b);
             s.intersect(rays.data() + b, c, h.data() + b, f + b);
             s.occluded(rays.data() + b, c, o + b);
-            s.occluders(rays.data() + b, c, sp.data() + b);
+            s.nearestOccluders(rays.data() + b, c, t.data() + b);
         }
         for (size_t i = 0; i < n; ++i) {
             ASSERT_EQ(f[i], bool(found[i])) << "chunk " << chunk << " ray " << i;
             EXPECT_EQ(o[i], bool(occ[i])) << "chunk " << chunk << " ray " << i;
-            EXPECT_EQ(sp[i].occluded, spans[i].occluded) << "chunk " << chunk << " ray " << i;
-            if (sp[i].occluded) {
-                EXPECT_EQ(sp[i].tNear, spans[i].tNear);
-                EXPECT_EQ(sp[i].tFar, spans[i].tFar);
-            }
+            EXPECT_EQ(t[i], nearest[i]) << "chunk " << chunk << " ray " << i;
             if (!f[i]) continue;
             EXPECT_EQ(0, std::memcmp(&h[i].position, &hits[i].position, sizeof(Vec3f))) << "chunk " << chunk << " ray " << i;
             EXPECT_EQ(0, std::memcmp(&h[i].normal, &hits[i].normal, sizeof(Vec3f)));

@@ -30,10 +30,11 @@ private:
 /// down to the grain, whatever the stealing), so a body that batches its tile's work (the
 /// sampler traces several pixels' rays as one Embree stream) batches it the same way. With
 /// TBB's auto_partitioner the ranges varied with the scheduling, and with them the streams; and
-/// a few samples' occluder spans depend, in their last bit, on the stream they are traced in
+/// a few samples' occluder spans depended, in their last bit, on the stream they were traced in
 /// (docs/posts.json with AAF: the slope AOV of 2 of 36864 pixels differed by one ulp in 1 run
 /// in 6 on two threads; between two tilings on one thread, 3 pixels; which rays, and whether in
-/// Embree's stream traversal or in wedge's arithmetic around it, is not isolated).
+/// Embree's stream traversal or in wedge's arithmetic around it, was not isolated; the spans'
+/// second, reversed query is gone since 2026-12-01).
 template <class Body>
 void parallelTiles(int width, int height, int tile, Body&& body) {
     tbb::parallel_for(tbb::blocked_range2d<int>(0, height, tile, 0, width, tile),

@@ -1,6 +1,6 @@
 // --method aaf: axis-aligned filtering with adaptive sampling for soft shadows, indirect light
 // and depth of field together (filter/aaf.h has the formulas). Stages: initial sampling (with
-// occluder spans for the slopes), prefilter (slope fill, bandwidths, rates), adaptive sampling,
+// the occluders' distances for the slopes), prefilter (slope fill, bandwidths, rates), adaptive sampling,
 // filter (direct and indirect separately, demodulated, then multiplied by albedo; last, the
 // defocus filter of the composited radiance, filter/defocus.h).
 #include <cmath>
@@ -22,7 +22,7 @@ void renderAaf(const MethodContext& ctxIn, RenderResult& result) {
     const int cap = std::max(ctx.options.maxExtraSpp, 0);
     FrameBuffers& fb = result.buffers;
 
-    // 1. Initial sampling: occluder spans give the shadow slopes (the stage includes first
+    // 1. Initial sampling: the nearest occluders give the shadow slopes (the stage includes first
     // touching the pixel statistics: 0.02-0.33 s at 512x512 on this machine).
     Timer t;
     PixelStatsImage stats(W, H);

@@ -1,5 +1,5 @@
 // --method maaf: multiple axis-aligned filters (filter/maaf.h) as in Sec. 6.2 of the paper.
-// Stages: initial sampling (16 path samples per pixel with occluder spans, folded into the
+// Stages: initial sampling (16 path samples per pixel with the nearest occluders, folded into the
 // pixel statistics); prefilter: AAF's slopes (with --maaf-paper-rates MAAF's, over a 5x5
 // window), the pixels whose indirect filter has outer components, the components (by default
 // only within the filter's window of those pixels) and AAF's rates; adaptive sampling at AAF's
@@ -140,7 +140,7 @@ void renderMaaf(const MethodContext& ctxIn, RenderResult& result) {
     result.extra.emplace_back("maaf_retrace", retrace ? 1.0 : 0.0);
     result.extra.emplace_back("maaf_initial_record_bytes", retrace ? 0.0 : double(initialRecordBytes));
 
-    // 1. Initial sampling: 16 path samples with occluder spans (the stage includes first
+    // 1. Initial sampling: 16 path samples with the nearest occluders (the stage includes first
     // touching the pixel statistics, as in AAF).
     Timer t;
     PixelStatsImage stats(W, H);

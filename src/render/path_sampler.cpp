@@ -241,9 +241,9 @@ PathSampler::LightSample PathSampler::sampleSphere(const scene::AreaLight& light
     return s;
 }
 
-TracedSample PathSampler::trace(int x, int y, uint32_t index, bool span) const {
+TracedSample PathSampler::trace(int x, int y, uint32_t index, bool slopes) const {
     TracedSample out;
-    traceBatch(x, y, index, 1, span, &out);
+    traceBatch(x, y, index, 1, slopes, &out);
     return out;
 }
 
@@ -321,7 +321,7 @@ struct PathSampler::Wave {
     scene::RaySegment rays[kLanes];
     uint16_t lane[kLanes];
     bool occluded[kLanes];
-    scene::OccluderSpan spans[kLanes];
+    float tOccluder[kLanes];
     // Where a batch of light samples is taken (PathSampler::sampleLights): the points, their
     // normals, numbers and light choices; for the bounces' hits, which bounce each is, its facet's
     // normal and the sample taken there.
@@ -343,12 +343,12 @@ struct PathSampler::Wave {
     }
 };
 
-void PathSampler::traceBatch(int x, int y, uint32_t first, uint32_t count, bool span, TracedSample* outs) const {
+void PathSampler::traceBatch(int x, int y, uint32_t first, uint32_t count, bool slopes, TracedSample* outs) const {
     const SampleRun run{x, y, first, count, outs};
-    traceMany(&run, 1, span);
+    traceMany(&run, 1, slopes);
 }
 
-void PathSampler::traceRuns(std::vector<SampleRun>& runs, std::vector<TracedSample>& buffer, bool span) const {
+void PathSampler::traceRuns(std::vector<SampleRun>& runs, std::vector<TracedSample>& buffer, bool slopes) const {
     size_t total = 0;
     for (const SampleRun& run : runs) total += run.count;
     if (buffer.size() < total) buffer.resize(total);
@@ -357,10 +357,10 @@ void PathSampler::traceRuns(std::vector<SampleRun>& runs, std::vector<TracedSamp
         run.out = buffer.data() + offset;
         offset += run.count;
     }
-    traceMany(runs.data(), runs.size(), span);
+    traceMany(runs.data(), runs.size(), slopes);
 }
 
-void PathSampler::traceMany(const SampleRun* runs, size_t nRuns, bool span) const {
+void PathSampler::traceMany(const SampleRun* runs, size_t nRuns, bool slopes) const {
     constexpr int K = scene::RayPacket::kSize;
     thread_local std::unique_ptr<Wave> scratch;
     if (!scratch) scratch = std::make_unique<Wave>();
@@ -495,13 +495,12 @@ void PathSampler::traceMany(const SampleRun* runs, size_t nRuns, bool span) cons
 
         // The wave's shadow rays as one stream.
         if (m_log) m_log->add(scene::RayLog::kShadow, w.rays, size_t(w.nRays));
-        if (span) {
-            m_scene.occluders(w.rays, size_t(w.nRays), w.spans);
+        if (slopes) {
+            m_scene.nearestOccluders(w.rays, size_t(w.nRays), w.tOccluder);
             for (int j = 0; j < w.nRays; ++j) {
                 TracedSample& o = *w.out[w.lane[j]];
-                o.occluded = w.spans[j].occluded;
-                o.tNear = w.spans[j].tNear;
-                o.tFar = w.spans[j].tFar;
+                o.tOccluder = w.tOccluder[j];
+                o.occluded = o.tOccluder < kInf;
             }
         } else {
             m_scene.occluded(w.rays, size_t(w.nRays), w.occluded);

@@ -67,7 +67,7 @@ struct TracedSample {
     bool shadowTested = false, occluded = false;
     bool selfShadowed = false;     // the light is above the shading normal's horizon but below the facet's
     float d1 = 0;                  // receiver -> light centre
-    float tNear = kInf, tFar = 0;  // occluder span along the shadow ray (span queries only)
+    float tOccluder = kInf;        // the nearest occluder's distance along the shadow ray (slope queries only)
     // Bounce.
     bool bounceHit = false;
     float bounceDistance = kInf;
@@ -84,12 +84,13 @@ public:
 
     PathSampler(const scene::Scene& scene, const Camera& camera, bool indirect, uint32_t seed);
 
-    /// Traces sample `index` of pixel (x, y). With `span`, the primary shadow ray collects the
-    /// nearest and farthest occluder (all hits along it) instead of stopping at the first.
-    TracedSample trace(int x, int y, uint32_t index, bool span) const;
+    /// Traces sample `index` of pixel (x, y). With `slopes`, the primary shadow ray finds the
+    /// occluder nearest the receiver (TracedSample::tOccluder, for the shadow slopes) instead of
+    /// stopping at any.
+    TracedSample trace(int x, int y, uint32_t index, bool slopes) const;
     /// Traces samples first .. first+count-1 of pixel (x, y) into out[0..count): traceMany with
     /// one run. The same samples as trace() one by one.
-    void traceBatch(int x, int y, uint32_t first, uint32_t count, bool span, TracedSample* out) const;
+    void traceBatch(int x, int y, uint32_t first, uint32_t count, bool slopes, TracedSample* out) const;
     /// Samples first .. first+count-1 of pixel (x, y), into out[0..count): one of traceMany's runs.
     struct SampleRun {
         int x = 0, y = 0;
@@ -99,10 +100,10 @@ public:
     /// Traces several pixels' runs together, so that Embree sees their shadow rays as one
     /// stream of up to 256 (faster than 16-wide packets: docs/sampling-speed.md). The same
     /// samples as traceBatch on each run.
-    void traceMany(const SampleRun* runs, size_t n, bool span) const;
+    void traceMany(const SampleRun* runs, size_t n, bool slopes) const;
     /// traceMany into `buffer`, grown to hold the runs' samples one run after another, with each
     /// run's `out` pointed at its part.
-    void traceRuns(std::vector<SampleRun>& runs, std::vector<TracedSample>& buffer, bool span) const;
+    void traceRuns(std::vector<SampleRun>& runs, std::vector<TracedSample>& buffer, bool slopes) const;
 
     /// The mean emitted radiance that the camera rays of samples 0 .. count-1 of pixel (x, y)
     /// see: the emitted part of those path samples, from their primary rays alone (no light

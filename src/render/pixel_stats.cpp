@@ -30,13 +30,19 @@ void SurfaceSlot::add(const TracedSample& s, const ViewGeometry& view, bool slop
     if (s.shadowTested) {
         ++nShadow;
         if (s.occluded && !s.selfShadowed) {
-            // NOTES (AAF 2012 code): d2min = d1 - t_far, d2max = d1 - t_near, s = d1/d2 - 1.
+            // s = d1/d2 - 1 with d2 the occluder's distance from the light (NOTES, AAF 2012);
+            // s1 the largest over the pixel's samples, s2 the smallest. The authors' code took
+            // each ray's nearest and farthest occluder (d2max = d1 - t_near, d2min = d1 - t_far);
+            // here each ray's nearest alone, one closest-hit query instead of two: a farther
+            // occluder hidden behind it on the same ray is seen by the pixel's other rays, or
+            // not at all. Measured (AAF, 512x512, relMSE against 1024-spp references): cornell,
+            // conference, sponza, bunny, cornell-sphere +0.0-0.2%, grids +1.0% (stacked slats),
+            // 0.2-1.3% fewer samples, the initial stage 5-13% faster (docs/sampling-speed.md).
             ++nOccluded;
             d1Sum += s.d1;
-            float d2min = std::max(s.d1 - s.tFar, 1e-3f * s.d1);
-            float d2max = std::max(s.d1 - s.tNear, 1e-3f * s.d1);
-            s1 = std::max(s1, s.d1 / d2min - 1.f);
-            s2 = std::min(s2, s.d1 / d2max - 1.f);
+            const float d2 = std::max(s.d1 - s.tOccluder, 1e-3f * s.d1);
+            s1 = std::max(s1, s.d1 / d2 - 1.f);
+            s2 = std::min(s2, s.d1 / d2 - 1.f);
             lightSigma = std::min(lightSigma, view.lights[r.light].sigma);
         }
     }

@@ -1,6 +1,6 @@
 // Per-pixel reduction of path samples into the FrameBuffers planes: the Monte Carlo estimate,
 // the demodulated direct and indirect light, the G-buffer, and the slope statistics of the
-// initial samples (shadow slopes from occluder spans, bounce distances, defocus slopes).
+// initial samples (shadow slopes from the nearest occluders, bounce distances, defocus slopes).
 //
 // Samples are grouped by the surface they hit (object, normal within 20 degrees, tangent
 // plane): the first kSlots surfaces a pixel sees get a slot each; the pixel's primary surface

@@ -303,37 +303,14 @@ void Scene::occluded(const RaySegment* rays, size_t n, bool* occluded) const {
     for (size_t i = 0; i < n; ++i) occluded[i] = rh[i].ray.tfar < 0;
 }
 
-void Scene::occluders(const RaySegment* rays, size_t n, OccluderSpan* spans) const {
-    // Two closest-hit queries instead of one traversal that visits every hit: the nearest
-    // occluder from the receiver, then, for the rays that found one, the nearest occluder seen
-    // from the segment's far end (the light) looking back, which is the farthest one from the
-    // receiver. Closest-hit traversal culls by distance and needs no filter callback; measured
-    // on Sponza 512x512 (16 spp with spans) it is faster than the all-hits filter (README).
+void Scene::nearestOccluders(const RaySegment* rays, size_t n, float* t) const {
     if (n == 0) return;
     std::vector<RTCRayHit>& rh = streamScratch(n);
     for (size_t i = 0; i < n; ++i) rh[i] = makeRayHit(rays[i].org, rays[i].dir, 0.f, rays[i].tFar, rays[i].time);
     RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
     rtcIntersect1M(m_scene, &ctx, rh.data(), unsigned(n), sizeof(RTCRayHit));
-    size_t back = 0;
-    for (size_t i = 0; i < n; ++i) {
-        const bool hit = rh[i].hit.geomID != RTC_INVALID_GEOMETRY_ID;
-        spans[i] = hit ? OccluderSpan{true, rh[i].ray.tfar, rh[i].ray.tfar} : OccluderSpan{};
-        if (!hit) continue;
-        // From the far end back to just past the nearest occluder, which it must find again at
-        // the latest (a small slack for the reversed ray's rounding).
-        float len = rays[i].tFar, slack = 1e-4f * len;
-        rh[back] = makeRayHit(rays[i].org + rays[i].dir * len, -rays[i].dir, 0.f, len - spans[i].tNear + slack, rays[i].time);
-        rh[back].ray.id = unsigned(i);
-        ++back;
-    }
-    if (back == 0) return;
-    rtcIntersect1M(m_scene, &ctx, rh.data(), unsigned(back), sizeof(RTCRayHit));
-    for (size_t j = 0; j < back; ++j) {
-        const unsigned i = rh[j].ray.id;
-        if (rh[j].hit.geomID != RTC_INVALID_GEOMETRY_ID)
-            spans[i].tFar = std::max(spans[i].tNear, rays[i].tFar - rh[j].ray.tfar);
-    }
+    for (size_t i = 0; i < n; ++i) t[i] = rh[i].hit.geomID != RTC_INVALID_GEOMETRY_ID ? rh[i].ray.tfar : kInf;
 }
 
 bool Scene::occluded(const Vec3f& org, const Vec3f& dir, float tNear, float tFar, float time) const {
@@ -344,16 +321,12 @@ bool Scene::occluded(const Vec3f& org, const Vec3f& dir, float tNear, float tFar
     return ray.tfar < 0;  // Embree sets tfar to -inf on a hit
 }
 
-OccluderSpan Scene::occluders(const Vec3f& org, const Vec3f& dir, float tNear, float tFar, float time) const {
+float Scene::nearestOccluder(const Vec3f& org, const Vec3f& dir, float tNear, float tFar, float time) const {
     // A stream of one, so that both paths are the same code.
     const RaySegment ray{org + dir * tNear, dir, tFar - tNear, time};
-    OccluderSpan span;
-    occluders(&ray, 1, &span);
-    if (span.occluded) {
-        span.tNear += tNear;
-        span.tFar += tNear;
-    }
-    return span;
+    float t;
+    nearestOccluders(&ray, 1, &t);
+    return t + tNear;
 }
 
 }  // namespace wedge::scene

@@ -1,7 +1,7 @@
 // The built scene: the only owner of Embree. Turns a SceneDesc into Embree geometry (triangle
 // meshes, sphere points, both with two time steps when they move) and answers the three ray
-// queries the sampler needs: closest hit, occlusion, and the span of all occluders along a
-// shadow segment (nearest and farthest hit, for the AAF/MAAF slopes).
+// queries the sampler needs: closest hit, occlusion, and the nearest occluder's distance along
+// a shadow segment (for the AAF/MAAF slopes).
 #pragma once
 
 #include <embree3/rtcore.h>
@@ -22,12 +22,6 @@ struct Hit {
     uint32_t object = 0;  // surface id: one per mesh shape (OBJ group) or primitive, one per sphere
     Vec3f albedo;         // the material's, textured at the hit (scene/checker.h)
     const RigidMotion* motion = nullptr;  // how the hit object moves over the shutter, or null: it is still
-};
-
-/// Nearest and farthest occluder distances along a segment (t measured from its origin).
-struct OccluderSpan {
-    bool occluded = false;
-    float tNear = kInf, tFar = 0.f;
 };
 
 /// Up to 16 rays as structure of arrays, for Embree's 16-wide packet queries. Lanes with
@@ -91,7 +85,8 @@ public:
     /// time in [0, 1] over the shutter.
     bool intersect(const Vec3f& org, const Vec3f& dir, float tNear, float tFar, float time, Hit& hit) const;
     bool occluded(const Vec3f& org, const Vec3f& dir, float tNear, float tFar, float time) const;
-    OccluderSpan occluders(const Vec3f& org, const Vec3f& dir, float tNear, float tFar, float time) const;
+    /// Distance from org to the nearest occluder within [tNear, tFar], or kInf where none.
+    float nearestOccluder(const Vec3f& org, const Vec3f& dir, float tNear, float tFar, float time) const;
 
     /// Closest hits of one pixel's camera rays (tNear = 0), coherent: one 16-wide packet.
     void intersect(const RayPacket& rays, Hit hits[RayPacket::kSize], bool found[RayPacket::kSize]) const;
@@ -102,7 +97,9 @@ public:
     void occluded(const RaySegment* rays, size_t n, bool* occluded) const;
     /// Closest hits of a stream (found[i] false where none).
     void intersect(const RaySegment* rays, size_t n, Hit* hits, bool* found) const;
-    void occluders(const RaySegment* rays, size_t n, OccluderSpan* spans) const;
+    /// The nearest occluder's distance along each segment of a stream (kInf where none): one
+    /// closest-hit query, without a hit record.
+    void nearestOccluders(const RaySegment* rays, size_t n, float* t) const;
     /// The Embree scene itself (benchmarks trace against it directly).
     RTCScene embree() const { return m_scene; }
 
