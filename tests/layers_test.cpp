@@ -716,6 +716,47 @@ TEST(Layers, WithoutDefocusAndMotionTheImageIsTheOneWithoutLayers) {
     }
 }
 
+TEST(Layers, ALightsRadianceScalesTheImageHoweverBright) {
+    // The samples' radiance is kept as RGB9E5 (at most 65408), scaled to the brightest emitter
+    // (LightFieldSamples::radianceScale). A lens and a bar over a lit floor, MC with layers, the
+    // light 10 and 10 x 2^20: the second image's light is the first's times 2^20. (Over the
+    // image: pixel by pixel the two differ by up to a few percent, since the stage's
+    // edge-stopping and its rays' tolerance add 0.01 to luminances, an absolute epsilon as
+    // relMSE's; with --layers off the two are exact multiples.) Unscaled, the bright render kept
+    // 13% of its light.
+    const std::string json = R"({
+      "camera": {"position": [0, 1.2, 2.2], "look_at": [0, 0.3, 0], "up": [0, 1, 0], "fov_y": 40, "resolution": [32, 32],
+                 "aperture_radius": 0.08, "focus_distance": 1.5},
+      "materials": {"grey": {"albedo": [0.6, 0.6, 0.6]}, "red": {"albedo": [0.7, 0.2, 0.1]}},
+      "lights": [{"type": "parallelogram", "corner": [-0.4, 2, -0.4], "edge1": [0.8, 0, 0], "edge2": [0, 0, 0.8], "radiance": RADIANCE}],
+      "objects": [{"type": "quad", "corner": [-3, 0, 3], "edge1": [6, 0, 0], "edge2": [0, 0, -6], "material": "grey"},
+                  {"type": "box", "min": [-0.5, 0.6, 0.4], "max": [0.5, 0.65, 0.6], "material": "red"}],
+      "render": {"spp": 8, "seed": 5, "indirect": true}
+    })";
+    auto withRadiance = [&](const std::string& r) {
+        std::string s = json;
+        s.replace(s.find("RADIANCE"), 8, "[" + r + ", " + r + ", " + r + "]");
+        return s;
+    };
+    render::RenderOptions o;
+    o.method = "mc";
+    o.layers = "on";
+    const render::RenderResult dim = renderJson(withRadiance("10"), o);
+    const render::RenderResult bright = renderJson(withRadiance("10485760"), o);  // 10 x 2^20
+    ASSERT_TRUE(dim.figure("layers_sample_bytes").has_value());
+    double sumDim = 0, sumBright = 0;
+    for (size_t i = 0; i < dim.color.size(); ++i) {
+        const Vec3f b = bright.color[i] * (1.f / 1048576.f);
+        ASSERT_TRUE(isFinite(b)) << i;
+        sumDim += dim.color[i].x + dim.color[i].y + dim.color[i].z;
+        sumBright += b.x + b.y + b.z;
+    }
+    EXPECT_GT(sumDim, 100.0);
+    EXPECT_NEAR(sumBright / sumDim, 1.0, 2e-3);
+    EXPECT_EQ(LightFieldSamples::radianceScaleFor(60.f), 1.f);  // the built-in scenes' are stored as they are
+    EXPECT_EQ(LightFieldSamples::radianceScaleFor(10485760.f), std::ldexp(1.f, -18));  // 10 x 2^20 -> 40
+}
+
 TEST(Layers, TheFiltersKeepOnlyTheAdaptiveSamplesThatCarryVisibility) {
     // A lit floor filling the view under a lens focused on it, with the soft shadow of a bar
     // outside the view: every pixel's samples see one untextured surface, so the samples aaf

@@ -12,6 +12,7 @@
 #include "render/camera.h"
 #include "render/pixel_stats.h"
 #include "render/methods.h"
+#include "render/output.h"
 #include "render/renderer.h"
 #include "scene/scene.h"
 #include "scene/scene_loader.h"
@@ -98,6 +99,33 @@ void expectPlaneMatches(const std::string& light, Irradiance irradiance) {
 }
 
 }  // namespace
+
+TEST(Render, SamplesWhoseLightIsNotFiniteAreCounted) {
+    // A radiance within float range (3e38) over a 10 x 10 light overflows the irradiance of the
+    // samples that see it to infinity: counted per sample (--stats nonfinite_samples), beside
+    // the pixels they reach (nonfinite_pixels, which `wedge render` warns of). A scene file
+    // takes radiance up to 1e15 (scene_loader.cpp, kMaxRadiance), so it is set here in the
+    // scene's description.
+    scene::SceneDesc d = parse(R"({
+      "camera": {"position": [0, 1, 3], "look_at": [0, 0, 0], "up": [0, 1, 0], "fov_y": 40, "resolution": [8, 8]},
+      "materials": {"white": {"albedo": [0.8, 0.8, 0.8]}},
+      "lights": [{"type": "parallelogram", "corner": [-0.5, 2, -0.5], "edge1": [10, 0, 0], "edge2": [0, 0, 10], "radiance": [5, 5, 5]}],
+      "objects": [{"type": "sphere", "center": [0, 0, 0], "radius": 0.5, "material": "white"}],
+      "render": {"spp": 2, "seed": 1, "indirect": true}
+    })");
+    for (auto& l : d.lights) l.radiance = Vec3f(3e38f);
+    for (auto& m : d.materials)
+        if (maxComponent(m.emission) > 0) m.emission = Vec3f(3e38f);
+    scene::Scene s(std::move(d));
+    render::RenderOptions o;
+    o.method = "mc";
+    o.quiet = true;
+    const render::RenderResult r = render::render(s, o);
+    const double samples = r.figure("nonfinite_samples").value_or(-1.0);
+    EXPECT_GT(samples, 0);
+    EXPECT_LE(samples, 8 * 8 * 2) << "at most every sample of the 8x8 render at 2 spp";
+    EXPECT_GT(render::nonFinitePixels(r), 0u);
+}
 
 TEST(Render, LambertFormulaSanity) {
     // A tiny light far above: E ~ L A / h^2.

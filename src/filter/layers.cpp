@@ -1670,6 +1670,7 @@ Image<uint8_t> pixelsAwayFromSilhouettes(const Image<uint8_t>& mixed, int reach)
 Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStats* stats, Image<uint8_t>* own) {
     const LightFieldSamples& lf = in.samples;
     const int W = lf.width(), H = lf.height();
+    const float invRadianceScale = 1.f / lf.radianceScale();  // (the samples' radiance as stored: LightFieldSamples)
     // How far from all of a layer's cells with samples a D can still change its coverage, in
     // cells (both D passes skip the Ds beyond it): N / D is 0 wherever the smoothed N is (its
     // Gaussian reaches rs cells), D's own Gaussian carries a change rs cells, and resolveCells'
@@ -1961,7 +1962,7 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                     const bool own = !l.sharp && (s.surface > 0 || (!l.moving && s.surface == 0 &&
                                                                     (c >= kOwnLightAll || (mixed[s.pixel] && c >= kOwnLightSlope))));
                     const Image3f* light = s.surface >= 0 && !own ? in.surfaceLight[s.surface] : nullptr;
-                    return light ? unpackRgb9e5(s.albedo) * (*light)[s.pixel] : unpackRgb9e5(s.radiance);
+                    return light ? unpackRgb9e5(s.albedo) * (*light)[s.pixel] : unpackRgb9e5(s.radiance) * invRadianceScale;
                 };
                 // A motion group's slope and depth over the shutter (slopeRate, depthRateOf), and
                 // the range of its samples' slopes at mid-shutter.

@@ -485,6 +485,13 @@ bool keepsSags(const scene::SceneDesc& desc) {
     return std::any_of(desc.meshes.begin(), desc.meshes.end(), [](const scene::TriangleMesh& m) { return m.turnDegrees != 0.f; });
 }
 
+float brightestEmitter(const scene::SceneDesc& desc) {
+    float brightest = 0.f;
+    for (const auto& l : desc.lights) brightest = std::max(brightest, maxComponent(l.radiance));
+    for (const auto& m : desc.materials) brightest = std::max(brightest, maxComponent(m.emission));
+    return brightest;
+}
+
 bool keepsLightField(const scene::SceneDesc& desc, const RenderOptions& options, int spp) {
     return options.layered(spp) && (desc.camera.apertureRadius > 0 || desc.hasMotion());
 }
@@ -512,7 +519,7 @@ RenderResult render(const scene::Scene& scene, const RenderOptions& options) {
     if (options.layers != "auto" && options.layers != "on" && options.layers != "off")
         throw Error("--layers", "expected auto, on or off, got '" + options.layers + "'");
     const bool layered = keepsLightField(desc, options, spp);
-    if (layered) lightField = LightFieldSamples(desc.camera.width, desc.camera.height, keepsSags(desc));
+    if (layered) lightField = LightFieldSamples(desc.camera.width, desc.camera.height, keepsSags(desc), brightestEmitter(desc));
     MethodContext ctx{scene, options, sampler, sampler.view(), spp, layered ? &lightField : nullptr};
 
     RenderResult result;

@@ -141,6 +141,9 @@ bool keepsLightField(const scene::SceneDesc& desc, const RenderOptions& options,
 /// Whether a kept light field keeps its samples' sagittas too (LightFieldSag, 4 bytes a sample):
 /// where an object of the scene turns (TracedSample::sag).
 bool keepsSags(const scene::SceneDesc& desc);
+/// The largest radiance component of the scene's lights and emissive materials (the light
+/// field's radianceScale).
+float brightestEmitter(const scene::SceneDesc& desc);
 
 RenderResult render(const scene::Scene& scene, const RenderOptions& options);
 

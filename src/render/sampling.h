@@ -41,7 +41,8 @@ public:
         const SampleRecord& r = s.record;
         if (m_lf->curved()) m_lf->sagRun(m_stage, p)[m_fill[p]] = LightFieldSag::pack(s.sag);
         m_lf->run(m_stage, p)[m_fill[p]++] = LightFieldSample::pack(
-            s.film, r.lens, s.time, s.hit ? s.depth : kInf, s.motion, s.albedo, s.albedo * (r.direct + r.indirect), slot);
+            s.film, r.lens, s.time, s.hit ? s.depth : kInf, s.motion, s.albedo,
+            s.albedo * (r.direct + r.indirect) * m_lf->radianceScale(), slot);
         // A bent path on a surface that turns towards or away from the camera (render/renderer.cpp,
         // leavePixelsToTheMethod). The sample lands in its layer's sharp image within |m| / 2 of
         // x, where a ray of a pixel within |m| / 2 of it reads it; the bend and the grid's blur

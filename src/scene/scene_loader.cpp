@@ -86,6 +86,11 @@ struct Transform {
 
 /// The largest scene coordinate (checkExtent) and shutter time wedge accepts.
 constexpr float kMaxCoordinate = 1e15f, kMaxShutterTime = 1e6f;
+/// The largest radiance component of a light or an emissive material. Sample values are summed
+/// and squared in single precision (a pixel's luminance variance, which à-trous's edge-stopping
+/// and the mixed pixels' top-ups read), and a single sample near a light can be a thousand times
+/// its radiance: at 1e20 à-trous's image was NaN everywhere (MC, AAF and MAAF still finite).
+constexpr float kMaxRadiance = 1e15f;
 /// The most a turning object turns over the shutter, in degrees (ten turns).
 constexpr double kMaxTurnDegrees = 3600;
 
@@ -176,7 +181,7 @@ private:
             mat.name = name;
             mat.albedo = m["albedo"].color();
             if (maxComponent(mat.albedo) > 1.f) m["albedo"].fail("albedo components must lie in [0, 1]");
-            if (auto e = m.optional("emission")) mat.emission = e->color();
+            if (auto e = m.optional("emission")) mat.emission = radiance(*e);
             if (auto t = m.optional("texture")) {
                 mat.texture = t->string();
                 if (mat.texture != "checker") t->fail("unknown texture '" + mat.texture + "' (expected \"checker\")");
@@ -200,13 +205,13 @@ private:
             if (light.sphere()) {
                 light.corner = l["center"].vec3();
                 light.radius = l["radius"].positive();
-                light.radiance = l["radiance"].color();
+                light.radiance = radiance(l["radiance"]);
                 checkExtent(l, {light.corner - Vec3f(light.radius), light.corner + Vec3f(light.radius)});
             } else {
                 light.corner = l["corner"].vec3();
                 light.edge1 = l["edge1"].vec3();
                 light.edge2 = l["edge2"].vec3();
-                light.radiance = l["radiance"].color();
+                light.radiance = radiance(l["radiance"]);
                 if (light.area() <= 0) l["edge2"].fail("edge1 and edge2 span no area");
                 Vec3f corners[4];
                 checkExtent(l, std::vector<Vec3f>(corners, corners + light.vertices(corners)));
@@ -380,6 +385,17 @@ private:
     /// +-kMaxCoordinate. Beyond about 1.8e18
     /// Embree rejects a ray's origin and direction (an assertion that aborts the process, as a
     /// sphere of radius 1e20 did), and squared distances overflow float near 1.8e19.
+    /// A colour of emitted radiance: non-negative, at most kMaxRadiance.
+    static Vec3f radiance(const JsonNode& node) {
+        const Vec3f v = node.color();
+        if (maxComponent(v) > kMaxRadiance) {
+            char c[96];
+            std::snprintf(c, sizeof c, "(%g, %g, %g)", v.x, v.y, v.z);
+            node.fail(std::string("radiance ") + c + " above 1e15, the most wedge renders");
+        }
+        return v;
+    }
+
     void checkExtent(const JsonNode& node, const std::vector<Vec3f>& points, const Vec3f& velocity = Vec3f(0.f)) const {
         const CameraDesc& cam = m_desc.camera;
         for (const Vec3f& p : points)
@@ -531,8 +547,9 @@ std::vector<uint32_t> appendMtlMaterials(const std::string& path, const std::str
         };
         if (!isFinite(mat.albedo) || std::min({mat.albedo.x, mat.albedo.y, mat.albedo.z}) < 0 || maxComponent(mat.albedo) > 1.f)
             bad("Kd", mat.albedo, "components must lie in [0, 1]");
-        if (!isFinite(mat.emission) || std::min({mat.emission.x, mat.emission.y, mat.emission.z}) < 0)
-            bad("Ke", mat.emission, "components must be finite and non-negative");
+        if (!isFinite(mat.emission) || std::min({mat.emission.x, mat.emission.y, mat.emission.z}) < 0 ||
+            maxComponent(mat.emission) > kMaxRadiance)
+            bad("Ke", mat.emission, "components must lie in [0, 1e15]");
         if (!m.diffuse_texname.empty()) mat.map = diffuseMap(path, where, m, cache, maps);
         mtlToScene.push_back(uint32_t(materials.size()));
         materials.push_back(mat);
