@@ -521,6 +521,8 @@ TEST(AnalysisCli, PenumbraWritesTheTableCsvAndPlot) {
         "analyze penumbra --spp -1 --pixel-width 0.02",
         "analyze penumbra --spp 16 --pixel-width nan",
         "analyze penumbra --spp 16 --pixel-width 1e-7",  // too many pixels within the kernel's reach
+        "analyze penumbra --spatial-scale 1e-30",        // a kernel reaching 1e30 (crashed: the offsets' count overflowed)
+        "analyze penumbra --window 1e30",
     });
     // With --spp the stratified variance and its ratio to the independent samples'.
     ASSERT_EQ(test::runWedge("analyze penumbra --points 11 --spp 16 --pixel-width 0.02", &out), 0);

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <limits>
 
 #include "core/error.h"
@@ -141,7 +142,19 @@ PenumbraResponse penumbraResponse(int pairs, const PenumbraSetup& set) {
     const double reach = kernel.reach;
     double h = std::min(1.0 / (8 * sxMax), s * L / 100);
     if (cxMax > 0) h = std::min(h, 2 * M_PI / (24 * cxMax));
-    const int na = 2 * int(std::ceil(reach / h)), ny = 256;
+    // The grid of offsets spans the kernel's reach at a step that resolves its finest Gaussian,
+    // the penumbra and the fastest cosine. A reach far beyond that (a spatial scale near 0, a
+    // window of 1e30) overflowed the count and crashed; bounded (256 light positions an offset:
+    // at most 512 MB of kernel values).
+    constexpr double kMaxOffsets = 262144;
+    const double offsets = 2 * std::ceil(reach / h);
+    if (!(offsets <= kMaxOffsets)) {
+        char why[200];
+        std::snprintf(why, sizeof why, "the kernel reaches %g and its finest detail needs a step of %g: more than %g offsets", reach, h,
+                      kMaxOffsets);
+        throw Error("--spatial-scale/--window", std::string(why) + " (a larger --spatial-scale or a smaller --window)");
+    }
+    const int na = int(offsets), ny = 256;
     h = 2 * reach / na;
     std::vector<double> a(na), y(ny), k(size_t(na) * ny);
     for (int j = 0; j < na; ++j) a[j] = -reach + (j + 0.5) * h;

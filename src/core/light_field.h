@@ -133,7 +133,7 @@ public:
     /// sphere light), and at 10^13 nearly all of it. The scale keeps the brightest emitter at most
     /// 64 (1 up to there: the built-in and docs/ scenes, at most 60, are stored as before), which
     /// leaves a sample 1000x the brightest radiance before it is clamped, and flushes to 0 only
-    /// what is below 1e-9 of it.
+    /// what is below about 2e-9 of it (2^-24 / 32).
     float radianceScale() const { return m_radianceScale; }
     static float radianceScaleFor(float brightest) {
         if (!(brightest > 64.f)) return 1.f;
