@@ -1671,7 +1671,7 @@ TEST(Render, MixedPixelsWhoseSurfacesAllMoveTakeFewerTopUps) {
             }
     }
     ASSERT_EQ(stats(0, 0).mixedTopUp(render::kMixedTau, render::kMixedSpp), 48u);
-    const Image<uint32_t> pooled = render::mixedTopUps(stats, render::blurPooling(&lf, view, {}));
+    const Image<uint32_t> pooled = render::mixedTopUps(stats, render::blurPooling(&lf, view, {}), 1.f);
     // Pixel 10's trail (pixels 0-20) moves but for pixel 20: tau x 0.5 x 20 x 20 / 21, 8.2
     // samples wanted, already 16.
     EXPECT_EQ(pooled(10, 0), 0u);
@@ -1683,8 +1683,8 @@ TEST(Render, MixedPixelsWhoseSurfacesAllMoveTakeFewerTopUps) {
     EXPECT_LT(pooled(30, 0), 48u);
     Image<uint8_t> bent(W, 1);
     bent(10, 0) = 1;  // a surface turning towards the camera near: aaf and maaf compose it themselves
-    EXPECT_EQ(render::mixedTopUps(stats, render::blurPooling(&lf, view, bent))(10, 0), 48u);
-    const Image<uint32_t> alone = render::mixedTopUps(stats, render::blurPooling(nullptr, view, {}));  // --layers off
+    EXPECT_EQ(render::mixedTopUps(stats, render::blurPooling(&lf, view, bent), 1.f)(10, 0), 48u);
+    const Image<uint32_t> alone = render::mixedTopUps(stats, render::blurPooling(nullptr, view, {}), 1.f);  // --layers off
     for (int x = 0; x < W; ++x) EXPECT_EQ(alone(x, 0), 48u);
 }
 
@@ -1714,7 +1714,7 @@ TEST(Render, MixedPixelsWhoseSurfacesAreAllDefocusedTakeFewerTopUps) {
             }
     }
     for (int x = 0; x < W; ++x) ASSERT_EQ(stats(x, 0).mixedTopUp(render::kMixedTau, render::kMixedSpp), 48u);
-    const Image<uint32_t> pooled = render::mixedTopUps(stats, render::blurPooling(&lf, view, {}));
+    const Image<uint32_t> pooled = render::mixedTopUps(stats, render::blurPooling(&lf, view, {}), 1.f);
     EXPECT_EQ(pooled(0, 0), 0u);
     EXPECT_GT(pooled(1, 0), 30u);
     EXPECT_LT(pooled(1, 0), 45u);
@@ -1722,7 +1722,7 @@ TEST(Render, MixedPixelsWhoseSurfacesAreAllDefocusedTakeFewerTopUps) {
     EXPECT_EQ(pooled(3, 0), 48u);
     Image<uint8_t> bent(W, 1);
     bent(0, 0) = 1;  // aaf and maaf compose it themselves
-    EXPECT_EQ(render::mixedTopUps(stats, render::blurPooling(&lf, view, bent))(0, 0), 48u);
+    EXPECT_EQ(render::mixedTopUps(stats, render::blurPooling(&lf, view, bent), 1.f)(0, 0), 48u);
 }
 
 TEST(Render, PixelStatsTakeFurtherSlotsOnlyForASecondSurface) {

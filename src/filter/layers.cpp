@@ -1086,7 +1086,8 @@ CellBox smooth(std::vector<float>& acc, int gw, int gh, int stride, float sigma,
 /// The radiance's edge-stopping Gaussian of `sigma` cells along grid axis `axis`, over channels
 /// [c0, stride) (W, R, G, B per time bin): neighbour k weighs exp(-k^2 / (2 sigma^2)) exp(-d^2 /
 /// 2), d the difference of the two cells' radiance (luminance over all time bins) relative to
-/// their mean, over `edge` (LayerOptions::edgeStop). The weight is symmetric and scales W with
+/// their mean plus `epsilon` (relMSE's 0.01 in LayerOptions::luminanceUnit), over `edge`
+/// (LayerOptions::edgeStop). The weight is symmetric and scales W with
 /// R, G, B, so a cell's radiance stays a weighted mean.
 /// (Without it across a crisp layer's motion, a moving object's samples that carry their own
 /// light were noisier inside its trail: AAF relMSE docs/motion.json +3%, many-motion +4%,
@@ -1095,7 +1096,8 @@ CellBox smooth(std::vector<float>& acc, int gw, int gh, int stride, float sigma,
 /// `box`: where those channels can be non-zero (CellBox); returns where they can be after (the
 /// box grown by the Gaussian's reach along the axis). Beyond that reach of the box a cell and
 /// all its neighbours are zero and add nothing: skipped, the same sums in the same order.
-CellBox smoothAcrossEdges(std::vector<float>& acc, int gw, int gh, int stride, int c0, float sigma, int axis, float edge, CellBox box) {
+CellBox smoothAcrossEdges(std::vector<float>& acc, int gw, int gh, int stride, int c0, float sigma, int axis, float edge, float epsilon,
+                          CellBox box) {
     const int n = stride - c0;
     const std::vector<float> taps = gaussianTaps(sigma);
     const int r = int(taps.size() / 2);
@@ -1128,7 +1130,7 @@ CellBox smoothAcrossEdges(std::vector<float>& acc, int gw, int gh, int stride, i
             if (!hasQ && !hasE) continue;
             float w = taps[size_t(r + k)];
             if (hasQ && hasE) {
-                const float d = (luminance[q] - luminance[e]) / (edge * (0.5f * (luminance[q] + luminance[e]) + 0.01f));
+                const float d = (luminance[q] - luminance[e]) / (edge * (0.5f * (luminance[q] + luminance[e]) + epsilon));
                 w *= std::exp(-0.5f * d * d);
             }
             float* oe = &out[e * n];
@@ -2653,7 +2655,8 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                         // its only Gaussian; LayerOptions::movingEdgeWidth, stillEdgeWidth).
                         if (const float width = l.moving ? o.movingEdgeWidth : o.stillEdgeWidth; width > 0.f)
                             for (int axis = 0; axis < 2; ++axis)
-                                radiance = smoothAcrossEdges(l.acc, l.gw, l.gh, l.accStride(), 2, width * sr, axis, o.edgeStop, radiance);
+                                radiance = smoothAcrossEdges(l.acc, l.gw, l.gh, l.accStride(), 2, width * sr, axis, o.edgeStop,
+                                                             0.01f * o.luminanceUnit, radiance);
                         box = box.united(radiance);
                     }
                     resolveCells(l, l.sharp ? 0.5f : 0.05f, box.united(boxD).grown(kFillRings, kFillRings, l.gw, l.gh));
@@ -2938,7 +2941,8 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                                     sum += v, sum2 += v * v;
                                 }
                                 const double mean = sum / rays, variance = std::max(0.0, sum2 / rays - mean * mean);
-                                straddles = variance >= double(o.rayTolerance) * double(rays) * (mean * mean + 0.01);
+                                const double unit = o.luminanceUnit;
+                                straddles = variance >= double(o.rayTolerance) * double(rays) * (mean * mean + 0.01 * unit * unit);
                             }
                             if (straddles) {
                                 trace(rays, mixedRays);

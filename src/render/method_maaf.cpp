@@ -238,7 +238,7 @@ void renderMaaf(const MethodContext& ctxIn, RenderResult& result) {
     Image<uint32_t> extra(W, H);
     const Image<uint32_t> emitterExtra = emitterTopUps(stats, kEmitterEdgeSpp);
     const Image<float> pooling = blurPooling(ctx.lightField, view, bentPixels(ctx), ctx.sampler.distribution());
-    const Image<uint32_t> mixedExtra = mixedTopUps(stats, pooling);
+    const Image<uint32_t> mixedExtra = mixedTopUps(stats, pooling, ctx.luminanceUnit);
     const Image<uint32_t> emitterEdges = emitterTopUps(stats, kEmitterEdgeRays);  // (denseEmission)
     uint64_t extraTotal = 0;
     // Whether an effect's filter at pixel p has outer components on either image axis.

@@ -23,6 +23,12 @@ struct MethodContext {
     /// Every sample, for the layered reconstruction (RenderOptions::layers); null when off or
     /// when the camera has no lens and nothing moves (nothing to reconstruct across pixels).
     LightFieldSamples* lightField = nullptr;
+    /// The luminance in which relMSE's epsilon 0.01 is measured where a method compares a
+    /// pixel's noise with its mean (the mixed pixels' top-ups, the layers' edge-stopping and extra
+    /// rays): 1 / LightFieldSamples::radianceScale, 1 where the brightest emitter is at most 64.
+    /// Above, a scene in brighter units samples and reconstructs as it would with its lights
+    /// scaled to 32-64, by a power of two (docs/reliability.md, "Linearity in the lights' radiance").
+    float luminanceUnit = 1.f;
 };
 
 void renderMc(const MethodContext& ctx, RenderResult& result);
@@ -114,8 +120,9 @@ Image<float> blurPooling(const LightFieldSamples* lightField, const ViewGeometry
 /// Adds `layers_defocused_mixed_share` to the result's figures where it decided.
 void settleLayers(MethodContext& ctx, const PixelStatsImage& stats, RenderResult& result);
 /// The mixed pixels' top-ups of aaf and maaf: PixelStats::mixedTopUp at kMixedTau times the
-/// pixel's `pooling` (blurPooling; empty: 1), up to kMixedSpp.
-Image<uint32_t> mixedTopUps(const PixelStatsImage& stats, const Image<float>& pooling);
+/// pixel's `pooling` (blurPooling; empty: 1), up to kMixedSpp, with relMSE's epsilon in
+/// MethodContext::luminanceUnit.
+Image<uint32_t> mixedTopUps(const PixelStatsImage& stats, const Image<float>& pooling, float luminanceUnit);
 /// The pixels within reach of a sample whose path bends on a surface turning towards or away
 /// from the camera (LightFieldSamples::bentReach, every rank's rows), where aaf and maaf keep
 /// their own composition (result.methodPixels); empty where there are none or no light field.

@@ -147,12 +147,12 @@ struct PixelStats {
     }
     /// Extra samples for a pixel whose samples saw more than one surface (or a surface and the
     /// background): no per-surface filter reaches how they mix, so such a pixel is sampled until
-    /// the relative variance of its mean, var / ((mean^2 + 0.01) n), falls to `tau`, at most up
-    /// to `target` samples in all.
-    uint32_t mixedTopUp(float tau, uint32_t target) const {
+    /// the relative variance of its mean, var / ((mean^2 + epsilon) n), falls to `tau`, at most
+    /// up to `target` samples in all (epsilon: relMSE's 0.01, MethodContext::luminanceUnit).
+    uint32_t mixedTopUp(float tau, uint32_t target, float epsilon = 0.01f) const {
         if (n == 0 || first.n == n || n >= target) return 0;
         float mean = lumSum / float(n), var = std::max(0.f, lumSq / float(n) - mean * mean);
-        float need = var / ((mean * mean + 0.01f) * tau);
+        float need = var / ((mean * mean + epsilon) * tau);
         return need > float(n) ? uint32_t(std::min(need, float(target))) - n : 0;
     }
     /// Writes this pixel into every plane of `fb`.

@@ -167,11 +167,13 @@ void settleLayers(MethodContext& ctx, const PixelStatsImage& stats, RenderResult
     ctx.lightField = nullptr;
 }
 
-Image<uint32_t> mixedTopUps(const PixelStatsImage& stats, const Image<float>& pooling) {
+Image<uint32_t> mixedTopUps(const PixelStatsImage& stats, const Image<float>& pooling, float luminanceUnit) {
     const int W = stats.width(), H = stats.height();
     Image<uint32_t> extra(W, H);
+    const float epsilon = 0.01f * luminanceUnit * luminanceUnit;
     parallelRows(H, [&](int y) {
-        for (int x = 0; x < W; ++x) extra(x, y) = stats(x, y).mixedTopUp(kMixedTau * (pooling.empty() ? 1.f : pooling(x, y)), kMixedSpp);
+        for (int x = 0; x < W; ++x)
+            extra(x, y) = stats(x, y).mixedTopUp(kMixedTau * (pooling.empty() ? 1.f : pooling(x, y)), kMixedSpp, epsilon);
     });
     return extra;
 }
@@ -325,6 +327,7 @@ Image3f reconstructFromLayers(const MethodContext& ctx,
     const FrameBuffers& fb = result.buffers;
     filter::LayerOptions lo;
     lo.seed = ctx.sampler.seed();
+    lo.luminanceUnit = ctx.luminanceUnit;
     // Samples that carry their own radiance (mc) are as noisy as a pixel's few samples: there a
     // near-focus layer (true blur at least half the grid's own at 16 samples per pixel, all of
     // it from 64) is reconstructed from the samples of its neighbourhood rather than its
@@ -520,7 +523,8 @@ RenderResult render(const scene::Scene& scene, const RenderOptions& options) {
         throw Error("--layers", "expected auto, on or off, got '" + options.layers + "'");
     const bool layered = keepsLightField(desc, options, spp);
     if (layered) lightField = LightFieldSamples(desc.camera.width, desc.camera.height, keepsSags(desc), brightestEmitter(desc));
-    MethodContext ctx{scene, options, sampler, sampler.view(), spp, layered ? &lightField : nullptr};
+    MethodContext ctx{scene, options, sampler, sampler.view(), spp, layered ? &lightField : nullptr,
+                      1.f / LightFieldSamples::radianceScaleFor(brightestEmitter(desc))};
 
     RenderResult result;
     result.method = options.method;
