@@ -120,9 +120,9 @@ class LightFieldSamples {
 public:
     LightFieldSamples() = default;
     /// `curved`: keep each sample's sagitta beside it (LightFieldSag; where an object turns).
-    /// `brightest`: the largest radiance component of the scene's emitters (radianceScaleFor).
-    LightFieldSamples(int width, int height, bool curved = false, float brightest = 0.f)
-        : m_width(width), m_height(height), m_curved(curved), m_radianceScale(radianceScaleFor(brightest)),
+    /// `radianceScale`: radianceScaleFor(the brightest emitter) (below).
+    LightFieldSamples(int width, int height, bool curved = false, float radianceScale = 1.f)
+        : m_width(width), m_height(height), m_curved(curved), m_radianceScale(radianceScale),
           m_bentReach(size_t(width) * height, 0.f) {}
     bool curved() const { return m_curved; }
 

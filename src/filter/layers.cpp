@@ -1086,7 +1086,7 @@ CellBox smooth(std::vector<float>& acc, int gw, int gh, int stride, float sigma,
 /// The radiance's edge-stopping Gaussian of `sigma` cells along grid axis `axis`, over channels
 /// [c0, stride) (W, R, G, B per time bin): neighbour k weighs exp(-k^2 / (2 sigma^2)) exp(-d^2 /
 /// 2), d the difference of the two cells' radiance (luminance over all time bins) relative to
-/// their mean plus `epsilon` (relMSE's 0.01 in LayerOptions::luminanceUnit), over `edge`
+/// their mean plus `epsilon` (relMSE's 0.01 in the light field's luminance unit), over `edge`
 /// (LayerOptions::edgeStop). The weight is symmetric and scales W with
 /// R, G, B, so a cell's radiance stays a weighted mean.
 /// (Without it across a crisp layer's motion, a moving object's samples that carry their own
@@ -1672,7 +1672,12 @@ Image<uint8_t> pixelsAwayFromSilhouettes(const Image<uint8_t>& mixed, int reach)
 Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStats* stats, Image<uint8_t>* own) {
     const LightFieldSamples& lf = in.samples;
     const int W = lf.width(), H = lf.height();
-    const float invRadianceScale = 1.f / lf.radianceScale();  // (the samples' radiance as stored: LightFieldSamples)
+    // The samples' radiance is stored times radianceScale (LightFieldSamples); its inverse is also
+    // the luminance in which the edge-stopping's and rayTolerance's epsilon, relMSE's 0.01, is
+    // measured (1 where the brightest emitter is at most 64, a power of two above: a scene in
+    // brighter units is treated as with its lights scaled to 32-64; docs/reliability.md,
+    // "Linearity in the lights' radiance"; MethodContext::luminanceUnit).
+    const float invRadianceScale = 1.f / lf.radianceScale();
     // How far from all of a layer's cells with samples a D can still change its coverage, in
     // cells (both D passes skip the Ds beyond it): N / D is 0 wherever the smoothed N is (its
     // Gaussian reaches rs cells), D's own Gaussian carries a change rs cells, and resolveCells'
@@ -2656,7 +2661,7 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                         if (const float width = l.moving ? o.movingEdgeWidth : o.stillEdgeWidth; width > 0.f)
                             for (int axis = 0; axis < 2; ++axis)
                                 radiance = smoothAcrossEdges(l.acc, l.gw, l.gh, l.accStride(), 2, width * sr, axis, o.edgeStop,
-                                                             0.01f * o.luminanceUnit, radiance);
+                                                             0.01f * invRadianceScale, radiance);
                         box = box.united(radiance);
                     }
                     resolveCells(l, l.sharp ? 0.5f : 0.05f, box.united(boxD).grown(kFillRings, kFillRings, l.gw, l.gh));
@@ -2941,7 +2946,7 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                                     sum += v, sum2 += v * v;
                                 }
                                 const double mean = sum / rays, variance = std::max(0.0, sum2 / rays - mean * mean);
-                                const double unit = o.luminanceUnit;
+                                const double unit = invRadianceScale;
                                 straddles = variance >= double(o.rayTolerance) * double(rays) * (mean * mean + 0.01 * unit * unit);
                             }
                             if (straddles) {

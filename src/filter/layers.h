@@ -185,11 +185,6 @@ struct LayerOptions {
     // -27% (docs/layers.md, "Moving layers' radiance, smoothed to its edges", "... and MC's
     // defocused layers").
     float movingEdgeWidth = 2.f, stillEdgeWidth = 0.f, edgeStop = 0.15f;
-    // The luminance in which the edge-stopping's and rayTolerance's epsilon, relMSE's 0.01, is
-    // measured: 1 / LightFieldSamples::radianceScale (1 where the brightest emitter is at most
-    // 64, a power of two above), so that a scene in brighter units is treated as it would be
-    // with its lights scaled to 32-64 (docs/reliability.md, "Linearity in the lights' radiance").
-    float luminanceUnit = 1.f;
 };
 
 struct LayerInput {

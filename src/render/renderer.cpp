@@ -327,7 +327,6 @@ Image3f reconstructFromLayers(const MethodContext& ctx,
     const FrameBuffers& fb = result.buffers;
     filter::LayerOptions lo;
     lo.seed = ctx.sampler.seed();
-    lo.luminanceUnit = ctx.luminanceUnit;
     // Samples that carry their own radiance (mc) are as noisy as a pixel's few samples: there a
     // near-focus layer (true blur at least half the grid's own at 16 samples per pixel, all of
     // it from 64) is reconstructed from the samples of its neighbourhood rather than its
@@ -522,9 +521,9 @@ RenderResult render(const scene::Scene& scene, const RenderOptions& options) {
     if (options.layers != "auto" && options.layers != "on" && options.layers != "off")
         throw Error("--layers", "expected auto, on or off, got '" + options.layers + "'");
     const bool layered = keepsLightField(desc, options, spp);
-    if (layered) lightField = LightFieldSamples(desc.camera.width, desc.camera.height, keepsSags(desc), brightestEmitter(desc));
-    MethodContext ctx{scene, options, sampler, sampler.view(), spp, layered ? &lightField : nullptr,
-                      1.f / LightFieldSamples::radianceScaleFor(brightestEmitter(desc))};
+    const float radianceScale = LightFieldSamples::radianceScaleFor(brightestEmitter(desc));
+    if (layered) lightField = LightFieldSamples(desc.camera.width, desc.camera.height, keepsSags(desc), radianceScale);
+    MethodContext ctx{scene, options, sampler, sampler.view(), spp, layered ? &lightField : nullptr, 1.f / radianceScale};
 
     RenderResult result;
     result.method = options.method;

@@ -381,10 +381,6 @@ private:
         if (m_desc.materials[mat].isEmitter()) addLights(o, faces, moving, owner);
     }
 
-    /// Every point, at the shutter's open and close (moved by velocity x (close - open)), within
-    /// +-kMaxCoordinate. Beyond about 1.8e18
-    /// Embree rejects a ray's origin and direction (an assertion that aborts the process, as a
-    /// sphere of radius 1e20 did), and squared distances overflow float near 1.8e19.
     /// A colour of emitted radiance: non-negative, at most kMaxRadiance.
     static Vec3f radiance(const JsonNode& node) {
         const Vec3f v = node.color();
@@ -396,6 +392,10 @@ private:
         return v;
     }
 
+    /// Every point, at the shutter's open and close (moved by velocity x (close - open)), within
+    /// +-kMaxCoordinate. Beyond about 1.8e18
+    /// Embree rejects a ray's origin and direction (an assertion that aborts the process, as a
+    /// sphere of radius 1e20 did), and squared distances overflow float near 1.8e19.
     void checkExtent(const JsonNode& node, const std::vector<Vec3f>& points, const Vec3f& velocity = Vec3f(0.f)) const {
         const CameraDesc& cam = m_desc.camera;
         for (const Vec3f& p : points)
