@@ -35,7 +35,9 @@
 //    kOrderBins; two moving layers by their depths in the cells where both were seen,
 //    kOrderVotes; orderLayers), and a sample counts in the D of the layers in front of its own at
 //    its time (not a sample nearer than all of a moving layer whose own layer lies wholly in front).
-// 2. Per layer, on a 1-pixel grid in its sharp image: N, the layer's samples at their own y; D,
+// 2. Per layer, on a grid of 1-pixel cells in its sharp image (of larger cells in a still layer
+//    blurred so far that its grid would reach more than LayerOptions::stillGridReach pixels
+//    beyond its tile): N, the layer's samples at their own y; D,
 //    those and the samples of every layer behind it at the layer's shear y = x + c_l u - m_l (t -
 //    1/2) (c_l, m_l its means); W, R, G, B, its samples' radiance at their own y, in 8 bins of
 //    shutter time for a moving layer (a moving surface's shading changes as it moves); and the
@@ -101,10 +103,20 @@ namespace wedge::filter {
 struct LayerOptions {
     int tile = 64;             // pixels
     int maxReach = 48;         // pixels: a tile gathers the samples whose trajectories reach it from at most this far (the cost bound)
-    // pixels: a blurred layer's grid reaches at most this far beyond its tile (its memory: (64 +
-    // 2 x 128)^2 cells); a layer whose blur, |c| + |m| / 2 + 3 sigma, would reach farther keeps
-    // its pixels' own samples (layers.cpp).
+    // cells: a blurred layer's grid reaches at most this far beyond its tile (its memory: (64 +
+    // 2 x 128)^2 cells); a moving layer's cells are pixels, and a tile with a moving layer whose
+    // blur, |c| + |m| / 2 + 3 sigma, would reach farther reconstructs no layer (each keeps its
+    // pixels' own samples, as without layers: layers.cpp, tileBeyondGrid).
     int maxGridMargin = 128;
+    // cells: a blurred still layer's grid reaches at most this far beyond its tile: where its
+    // blur would take a grid of 1-px cells farther, its cells are larger (Layer::step), so that
+    // a blur of any size is reconstructed at a bounded cost. (Of the built-in and docs/ scenes
+    // only docs/sponza-motion.json has such a layer, its relMSE the same to six digits. Beyond
+    // 128 px, before, a
+    // layer kept its pixels' own samples, and composited with the blurred layers behind it the
+    // light behind a near column showed through it: docs/layers.md, "Blur past the grid's
+    // reach".)
+    int stillGridReach = 32;
     float sigmaScale = 0.15f;  // the sharp image's Gaussian: sigmaScale |c_l|, clamped to [sigmaMin, sigmaMax]
     float sigmaMin = 0.5f, sigmaMax = 2.f;
     // ... and the coverage's (N, D) and the slopes': sigmaScale |c_l| clamped to [sigmaCoverageMin,
