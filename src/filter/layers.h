@@ -111,10 +111,10 @@ struct LayerOptions {
     // cells: a blurred still layer's grid reaches at most this far beyond its tile: where its
     // blur would take a grid of 1-px cells farther, its cells are larger (Layer::step), so that
     // a blur of any size is reconstructed at a bounded cost. (Of the built-in and docs/ scenes
-    // only docs/sponza-motion.json has such a layer, its relMSE the same to six digits. Beyond
-    // 128 px, before, a layer kept its pixels' own samples, and composited with the blurred
-    // layers behind it the light behind a near column showed through it: docs/layers.md, "Blur
-    // past the grid's reach".)
+    // only sponza at 512x512 and docs/sponza-motion.json have such a layer, their relMSE the
+    // same to five digits. Beyond 128 px, before, a layer kept its pixels' own samples, and
+    // composited with the blurred layers behind it the light behind a near column showed
+    // through it: docs/layers.md, "Blur past the grid's reach".)
     int stillGridReach = 32;
     float sigmaScale = 0.15f;  // the sharp image's Gaussian: sigmaScale |c_l|, clamped to [sigmaMin, sigmaMax]
     float sigmaMin = 0.5f, sigmaMax = 2.f;
