@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstring>
 #include <random>
+#include <vector>
 
 #include "core/error.h"
 #include "core/light_field.h"
@@ -518,18 +519,12 @@ TEST(Layers, ANearSurfaceInSlicesOfLargeBlurHidesWhatIsBehindIt) {
     const render::RenderResult off = renderJson(json, o);
     o.layers = "on";
     const render::RenderResult on = renderJson(json, o);
-    double brightest = 0;
-    for (int x = 0; x < 128; ++x) {
-        double column = 0;
-        for (int y = 0; y < 24; ++y) column += reference.color(x, y).y / 24;
-        brightest = std::max(brightest, column);
-    }
+    std::vector<double> column(128, 0.0);  // the reference's column means
+    for (int x = 0; x < 128; ++x)
+        for (int y = 0; y < 24; ++y) column[size_t(x)] += reference.color(x, y).y / 24;
+    const double brightest = *std::max_element(column.begin(), column.end());
     ASSERT_GT(brightest, 0.01);
-    const ColumnErrors e = columnErrors(on.color, off.color, [&](int x) {
-        double column = 0;
-        for (int y = 0; y < 24; ++y) column += reference.color(x, y).y / 24;
-        return column;
-    }, brightest);
+    const ColumnErrors e = columnErrors(on.color, off.color, [&](int x) { return column[size_t(x)]; }, brightest);
     EXPECT_LT(e.worstColumn, 0.08) << "the largest difference of a column's mean from the reference's, of the brightest column";
     EXPECT_LT(e.squaredOn, 0.3 * e.squaredOff) << "the layers' squared error against Monte Carlo's, each from the reference's column";
 }

@@ -2301,7 +2301,7 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                         const float gridBlur = sqr(float(l.step)) * (kCellBlur + sqr(l.sigmaCoverage));  // (pixels^2)
                         l.gridBlur = l.lensBlur = gridBlur;
                         l.shapeRays(motion);
-                        lm = int(std::ceil(gridReach)) + 1;  // (at most maxGridMargin: above)
+                        lm = int(std::ceil(gridReach)) + 1;  // (at most stepOf's bound: above)
                         anyBlurred = true;
                     }
                     // (In cells; with a step of 1, X0 - lm to X1 + lm.)
