@@ -639,13 +639,25 @@ TEST(Layers, AMotionLongerThanATilesReachIsReconstructedInEveryTile) {
     EXPECT_LT(e.squaredOn, 0.3 * e.squaredOff) << "the layers' squared error against the Monte Carlo estimate's";
 }
 
+TEST(Layers, AMotionAlongOneAxisIsReconstructedHoweverLong) {
+    // 297 px over the shutter: half of it is past LayerOptions::maxGridMargin (128 px), which
+    // bounded a moving layer's grid along both axes; its pixels kept their own samples (Monte
+    // Carlo's error: 1.00x). A moving layer's grid now reaches along each axis as far as its
+    // motion there, within the cells of one reaching 128 px both ways (measured: worst column
+    // 0.0092 of the strip's radiance, 0.044x Monte Carlo's squared error).
+    const ColumnErrors e = movingStripErrors(13.f, 64, 256, -4.7f, 2.f);
+    EXPECT_LT(e.worstColumn, 0.03) << "the largest difference of a column's mean, of the strip's radiance";
+    EXPECT_LT(e.squaredOn, 0.3 * e.squaredOff) << "the layers' squared error against the Monte Carlo estimate's";
+}
+
 TEST(Layers, AMotionPastTheGridsBoundKeepsItsPixelsOwnSamples) {
-    // 297 px over the shutter: half of it is past LayerOptions::maxGridMargin (128 px), so the
-    // strip's layer is not reprojected and its pixels keep their own samples, unbiased (as
-    // Monte Carlo's: measured 1.00x its squared error, worst column 0.008 of the strip's
-    // radiance at 256 samples a pixel), over the whole shutter, not one time bin's (which measured
-    // 10.9x).
-    const ColumnErrors e = movingStripErrors(13.f, 256, 256, -4.7f, 2.f);
+    // 1500 px over the shutter along x: a grid reaching 750 px beyond its tile along x has more
+    // cells than one reaching LayerOptions::maxGridMargin (128 px) both ways, so no layer of its
+    // tiles is reprojected and their pixels keep their own samples, unbiased (as Monte Carlo's:
+    // measured the same squared error, worst column 0.018 of the strip's radiance), over the
+    // whole shutter, not one time bin's (which measured 10.9x Monte Carlo's squared error, on a
+    // 297-px motion when that was past the bound).
+    const ColumnErrors e = movingStripErrors(65.6f, 128, 1600, -34.f, 2.f);
     EXPECT_LT(e.worstColumn, 0.03) << "the largest difference of a column's mean, of the strip's radiance";
     EXPECT_GT(e.squaredOn, 0.9 * e.squaredOff) << "not reprojected: Monte Carlo's error";
     EXPECT_LT(e.squaredOn, 1.1 * e.squaredOff) << "the layers' squared error against the Monte Carlo estimate's";

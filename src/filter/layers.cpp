@@ -344,7 +344,7 @@ CellBox nonZeroBox(const std::vector<float>& grid, int gw, int gh, int stride = 
 }
 
 struct Layer {
-    double sumC = 0, sumMx = 0, sumMy = 0, sumM2 = 0, sumInvDepth = 0;  // sumM2: of |motion|^2
+    double sumC = 0, sumMx = 0, sumMy = 0, sumM2 = 0, sumMx2 = 0, sumInvDepth = 0;  // sumM2: of |motion|^2; sumMx2: of its x's square
     float cMin = kInf, cMax = -kInf;
     float invDepthMax = 0;  // of its nearest sample (0: a miss)
     float invDepthMin = kInf;  // of its farthest
@@ -361,6 +361,9 @@ struct Layer {
     // side and the other way on the other, its mean motion near nothing: judged by the mean, its
     // layer was sharp and its samples stayed where they were taken).
     float motionRms = 0;
+    // ... and its x and y components' (a layer's grid reaches along each axis as far as its motion
+    // there: reachAxes in reconstructLayers).
+    float motionRmsX = 0, motionRmsY = 0;
     // The rays' shear, shaped by the grid's own blur (Shaped): a ray at lens point u (unit disc)
     // is sheared by (rayC + rayC2 |u|^2) u, one at time t by (1 + rayT2 (2 s)^2) s rayM, s = t -
     // 1/2. A ray that takes the slope c of the surface it finds is sheared by (A(c) + B(c)
@@ -517,7 +520,7 @@ struct Split {
         float cHi = 0, binW = 1;
         int bins = 0, base = 0;
         std::vector<int> count, binLayer;
-        std::vector<double> sumC, sumMx, sumMy, sumM2, sumInvDepth;
+        std::vector<double> sumC, sumMx, sumMy, sumM2, sumMx2, sumInvDepth;
         std::vector<float> cMin, cMax, invMax, invMin;
         std::vector<uint8_t> sharpRun;  // per layer of the class: a merged run of sharp layers
         float invBinW = 0;  // 1 / binW where that is exact (binW a power of two, as the least, 0.25, is), else 0
@@ -540,6 +543,7 @@ void addBin(Layer& l, const Split::Histogram& h, int b) {
     l.sumMx += h.sumMx[b];
     l.sumMy += h.sumMy[b];
     l.sumM2 += h.sumM2[b];
+    l.sumMx2 += h.sumMx2[b];
     l.sumInvDepth += h.sumInvDepth[b];
     l.cMin = std::min(l.cMin, h.cMin[b]);
     l.cMax = std::max(l.cMax, h.cMax[b]);
@@ -874,7 +878,7 @@ void splitLayers(Samples& g, const SlopeRange (&range)[kClasses], const float (&
         h.bins = int((r.hi - r.lo) / h.binW) + 1;
         h.count.assign(h.bins, 0);
         h.binLayer.assign(h.bins, -1);
-        for (auto* v : {&h.sumC, &h.sumMx, &h.sumMy, &h.sumM2, &h.sumInvDepth}) v->assign(h.bins, 0.0);
+        for (auto* v : {&h.sumC, &h.sumMx, &h.sumMy, &h.sumM2, &h.sumMx2, &h.sumInvDepth}) v->assign(h.bins, 0.0);
         h.cMin.assign(h.bins, kInf);
         h.cMax.assign(h.bins, -kInf);
         h.invMax.assign(h.bins, 0.f);
@@ -885,7 +889,7 @@ void splitLayers(Samples& g, const SlopeRange (&range)[kClasses], const float (&
     // the bin changes (summing into the bin sample by sample chained every add through memory).
     struct Run {
         int bin = -1, count = 0;
-        double c = 0, mx = 0, my = 0, m2 = 0, invDepth = 0;
+        double c = 0, mx = 0, my = 0, m2 = 0, mx2 = 0, invDepth = 0;
         float cMin = kInf, cMax = -kInf, invMax = 0, invMin = kInf;
     };
     Run run[kClasses];
@@ -898,6 +902,7 @@ void splitLayers(Samples& g, const SlopeRange (&range)[kClasses], const float (&
         h.sumMx[r.bin] += r.mx;
         h.sumMy[r.bin] += r.my;
         h.sumM2[r.bin] += r.m2;
+        h.sumMx2[r.bin] += r.mx2;
         h.sumInvDepth[r.bin] += r.invDepth;
         h.cMin[r.bin] = std::min(h.cMin[r.bin], r.cMin);
         h.cMax[r.bin] = std::max(h.cMax[r.bin], r.cMax);
@@ -922,6 +927,7 @@ void splitLayers(Samples& g, const SlopeRange (&range)[kClasses], const float (&
             r.mx += s.mx;
             r.my += s.my;
             r.m2 += s.mx * s.mx + s.my * s.my;
+            r.mx2 += double(s.mx) * double(s.mx);
             r.invDepth += s.invDepth;
             r.cMin = std::min(r.cMin, s.c);
             r.cMax = std::max(r.cMax, s.c);
@@ -979,6 +985,8 @@ void splitLayers(Samples& g, const SlopeRange (&range)[kClasses], const float (&
         l.mx = float(l.sumMx * inv);
         l.my = float(l.sumMy * inv);
         l.motionRms = float(std::sqrt(l.sumM2 * inv));
+        l.motionRmsX = float(std::sqrt(l.sumMx2 * inv));
+        l.motionRmsY = float(std::sqrt(std::max(0.0, l.sumM2 - l.sumMx2) * inv));
         l.invDepth = float(l.sumInvDepth * inv);
     }
     // Front to back: by mean inverse depth (a miss is at 0), which orders layers of any slope; a
@@ -2228,14 +2236,35 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                 auto reachIn = [&](const Layer& l, int step) {
                     return (std::abs(l.c) + chordReach(l.depthRate) * l.motionRms) / float(step) + 3.f * sigmaIn(l, step);
                 };
+                // ... along x and along y apart: the lens's disc and the Gaussian both ways, the
+                // motion as far as it goes along each (a still layer's, both reachIn).
+                auto reachAxes = [&](const Layer& l, int step) {
+                    const float k = chordReach(l.depthRate), s3 = 3.f * sigmaIn(l, step);
+                    return Vec2f{(std::abs(l.c) + k * l.motionRmsX) / float(step) + s3, (std::abs(l.c) + k * l.motionRmsY) / float(step) + s3};
+                };
+                // The most cells a grid may have: a still layer's (or a moving one's) that reaches
+                // maxGridMargin beyond its tile both ways.
+                const float maxCells = sqr(float(o.tile + 2 * o.maxGridMargin));
                 // The cell size that keeps a layer's grid within LayerOptions::stillGridReach
-                // cells of its tile (a still layer) or maxGridMargin (a moving one): 1 pixel, or
-                // for a still layer past that the fewest pixels that do; 0 where none will (a
+                // cells of its tile (a still layer) or within maxCells (a moving one): 1 pixel,
+                // or for a still layer past that the fewest pixels that do; 0 where none will (a
                 // moving layer, whose motion grid, time bins and motion fits are a 1-px grid's).
                 auto stepOf = [&](const Layer& l) {
-                    const float bound = float(l.moving ? o.maxGridMargin : std::min(o.maxGridMargin, o.stillGridReach)) - 1.f;
+                    if (l.moving) {
+                        // A moving layer's grid reaches along each axis as far as its motion
+                        // there (a streak across the image, far along x and no farther than its
+                        // blur along y); it fits where it has no more cells than a grid reaching
+                        // maxGridMargin both ways. (Before, its reach in both axes was the
+                        // motion's length, bounded by maxGridMargin: a sphere moving 264 px kept
+                        // its pixels' own samples, and so did motion of 282 px, docs/motion.json
+                        // rendered at 1024x1024; docs/layers.md, "A moving layer's grid per axis".)
+                        const Vec2f r = reachAxes(l, 1);
+                        const float cells = (float(o.tile) + 2.f * (std::ceil(r.x) + 1.f)) * (float(o.tile) + 2.f * (std::ceil(r.y) + 1.f));
+                        return cells <= maxCells ? 1 : 0;
+                    }
+                    const float bound = float(std::min(o.maxGridMargin, o.stillGridReach)) - 1.f;
                     if (reachIn(l, 1) <= bound) return 1;
-                    if (l.moving || bound <= 3.f * o.sigmaMax) return 0;
+                    if (bound <= 3.f * o.sigmaMax) return 0;
                     const float first = std::ceil(std::abs(l.c) / (bound - 3.f * o.sigmaMax));
                     if (!(first < float(1 << 20))) return 0;
                     int step = std::max(2, int(first));
@@ -2266,7 +2295,8 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                     // it they give the true blur, a disc of radius |c| (c^2 / 4 per axis) and a
                     // segment of length |m| (m^2 / 12); a layer whose true blur is below the
                     // grid's own with the smallest sigma is sharp.
-                    // A blurred layer's grid reaches |c| + |m| / 2 + 3 sigma beyond its tile,
+                    // A blurred layer's grid reaches |c| + |m| / 2 + 3 sigma beyond its tile
+                    // (a moving one's along each axis with that axis's motion: reachAxes),
                     // wherever the rays read it, also past the trajectories a tile gathers
                     // (LayerOptions::maxReach): there it holds only the samples gathered, but N
                     // and D alike (the samples of the same source pixels), so its coverage stays
@@ -2274,16 +2304,16 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                     // maxReach, a fast box's 220-px trail lost its ends: the rays read the
                     // clamped edge of the grid; docs/layers.md, "Motion longer than a tile's reach, and an object moving in depth".)
                     // Past LayerOptions::stillGridReach a still layer's cells are larger (stepOf);
-                    // past maxGridMargin a moving layer fits in no grid, and then no layer of the
-                    // tile is reprojected (tileBeyondGrid, above).
+                    // with more cells than one reaching maxGridMargin both ways a moving layer fits
+                    // in no grid, and then no layer of the tile is reprojected (tileBeyondGrid, above).
                     const bool forcedSharp = l.sharpRun || tileBeyondGrid;
                     l.sharp = forcedSharp || isSharp(l.c, spread, motion, o);
                     l.rayC = l.c, l.rayMx = l.mx, l.rayMy = l.my;
-                    int lm = 0;  // the grid's margin beyond the tile, in cells
+                    int lmx = 0, lmy = 0;  // the grid's margins beyond the tile, in cells
                     l.step = l.sharp ? 1 : stepOf(l);
                     l.invStep = 1.f / float(l.step);
                     const float sigma = sigmaIn(l, l.step);
-                    const float gridReach = reachIn(l, l.step);  // beyond the tile, the rays' cells
+                    const Vec2f gridReach = reachAxes(l, l.step);  // beyond the tile, the rays' cells
                     if (!l.sharp) {
                         // (Not widened by the slopes' spread: the rays follow the slope they find. Half the
                         // spread, as it was, over-blurred the layers a tile's budget had widened: AAF
@@ -2301,14 +2331,15 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                         const float gridBlur = sqr(float(l.step)) * (kCellBlur + sqr(l.sigmaCoverage));  // (pixels^2)
                         l.gridBlur = l.lensBlur = gridBlur;
                         l.shapeRays(motion);
-                        lm = int(std::ceil(gridReach)) + 1;  // (at most stepOf's bound: above)
+                        lmx = int(std::ceil(gridReach.x)) + 1;  // (within stepOf's bound: above)
+                        lmy = int(std::ceil(gridReach.y)) + 1;
                         anyBlurred = true;
                     }
-                    // (In cells; with a step of 1, X0 - lm to X1 + lm.)
-                    l.gx0 = X0 / l.step - lm;
-                    l.gy0 = Y0 / l.step - lm;
-                    l.gw = (X1 + l.step - 1) / l.step + lm - l.gx0;
-                    l.gh = (Y1 + l.step - 1) / l.step + lm - l.gy0;
+                    // (In cells; with a step of 1, X0 - lmx to X1 + lmx.)
+                    l.gx0 = X0 / l.step - lmx;
+                    l.gy0 = Y0 / l.step - lmy;
+                    l.gw = (X1 + l.step - 1) / l.step + lmx - l.gx0;
+                    l.gh = (Y1 + l.step - 1) / l.step + lmy - l.gy0;
                     // (A sharp layer's pixels take one ray where the whole tile is sharp: its
                     // radiance is its pixel's samples over the whole shutter, not one bin's.)
                     l.timeBins = l.moving && !l.sharp ? kTimeBins : 1;
