@@ -34,6 +34,15 @@ render::RenderResult renderJson(const std::string& json, render::RenderOptions o
     o.quiet = true;
     return render::render(s, o);
 }
+/// Monte Carlo with `layers` (on, off) at `spp` samples a pixel and `seed`.
+render::RenderResult renderMc(const std::string& json, const char* layers, int spp, int seed) {
+    render::RenderOptions o;
+    o.method = "mc";
+    o.layers = layers;
+    o.spp = spp;
+    o.seed = seed;
+    return renderJson(json, o);
+}
 
 /// A W x H view of focal length 100 px under a lens of radius 0.1 focused at 2.
 ViewGeometry wideLensView(int W, int H) {
@@ -508,17 +517,9 @@ TEST(Layers, ANearSurfaceInSlicesOfLargeBlurHidesWhatIsBehindIt) {
                   {"type": "quad", "corner": [-50, -50, -8], "edge1": [100, 0, 0], "edge2": [0, 100, 0], "material": "grey"}],
       "render": {"spp": 16, "seed": 2, "indirect": false}
     })", x1 - 10, -d1, x2 - 10, -d2);
-    render::RenderOptions o;
-    o.method = "mc";
-    o.layers = "off";
-    o.spp = 1024;
-    o.seed = 77;
-    const render::RenderResult reference = renderJson(json, o);
-    o.spp = 64;
-    o.seed = 2;
-    const render::RenderResult off = renderJson(json, o);
-    o.layers = "on";
-    const render::RenderResult on = renderJson(json, o);
+    const render::RenderResult reference = renderMc(json, "off", 1024, 77);
+    const render::RenderResult off = renderMc(json, "off", 64, 2);
+    const render::RenderResult on = renderMc(json, "on", 64, 2);
     std::vector<double> column(128, 0.0);  // the reference's column means
     for (int x = 0; x < 128; ++x)
         for (int y = 0; y < 24; ++y) column[size_t(x)] += reference.color(x, y).y / 24;
@@ -679,16 +680,8 @@ TEST(Layers, ASphereMovingSidewaysCoversTheMiddleOfItsTrail) {
       "objects": [{"type": "sphere", "center": [-0.4, 0, -2.4], "radius": 0.4, "material": "white", "velocity": [0.8, 0, 0]}],
       "render": {"spp": 16, "seed": 3, "indirect": false}
     })";
-    render::RenderOptions o;
-    o.method = "mc";
-    o.layers = "off";
-    o.spp = 256;
-    o.seed = 77;
-    const render::RenderResult reference = renderJson(json, o);
-    o.spp = 16;
-    o.seed = 3;
-    o.layers = "on";
-    const render::RenderResult on = renderJson(json, o);
+    const render::RenderResult reference = renderMc(json, "off", 256, 77);
+    const render::RenderResult on = renderMc(json, "on", 16, 3);
     double middle = 0, middleOn = 0;  // the mean of the middle 40 columns
     for (int x = 140; x < 180; ++x)
         for (int y = 0; y < 24; ++y) middle += reference.color(x, y).y, middleOn += on.color(x, y).y;
