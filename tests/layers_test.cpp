@@ -665,7 +665,7 @@ TEST(Layers, AMotionPastTheGridsBoundKeepsItsPixelsOwnSamples) {
 }
 
 TEST(Layers, ASphereMovingSidewaysCoversTheMiddleOfItsTrail) {
-    // A sphere 2.4 units away moving sideways by about its own width (155 px at its rim, 176 px
+    // A sphere 2.4 units away moving sideways by about its own width (157 px at its rim, 183 px
     // at its front: nearer, it moves faster on screen) over nothing, against a 256-spp render
     // without layers. The middle of its trail is covered for the whole shutter, by its rims
     // early and late. A ray there, and a sample of the sky beside a rim, start on the layer
