@@ -441,7 +441,8 @@ struct Layer {
     // A blurred moving layer whose samples move along one grid axis only (and are in focus) keeps
     // the other axis crisp: its lookup there the nearest cell, the pixel's own row (column) of
     // samples, and no Gaussian across the motion but the radiance's, stopped at edges
-    // (smoothAcrossEdges) (-1: neither; 0: x crisp; 1: y).
+    // (smoothAcrossEdges), or where the samples carry their own light its plain one
+    // (LayerOptions::crispRadiance) (-1: neither; 0: x crisp; 1: y).
     int crisp = -1;
     float sigmaX(float s) const { return crisp == 0 ? 0.f : s; }
     float sigmaY(float s) const { return crisp == 1 ? 0.f : s; }
@@ -2782,11 +2783,13 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                     if (!l.sharp) {
                         const float sc = l.sigmaCoverage, sr = l.sigma;
                         CellBox radiance;  // (of W, R, G, B)
-                        if (sc == sr) {
+                        const bool plainRadiance = l.crisp >= 0 && !o.crispRadiance;
+                        if (sc == sr && !plainRadiance) {
                             radiance = smooth(l.acc, l.gw, l.gh, l.accStride(), l.sigmaX(sr), l.sigmaY(sr), box);
                         } else {
                             const CellBox coverage = smooth(l.acc, l.gw, l.gh, l.accStride(), l.sigmaX(sc), l.sigmaY(sc), box, 0, 2);  // N, the slopes
-                            radiance = smooth(l.acc, l.gw, l.gh, l.accStride(), l.sigmaX(sr), l.sigmaY(sr), box, 2);                   // W, R, G, B
+                            radiance = smooth(l.acc, l.gw, l.gh, l.accStride(), plainRadiance ? sr : l.sigmaX(sr), plainRadiance ? sr : l.sigmaY(sr), box,
+                                              2);  // W, R, G, B
                             box = coverage;
                         }
                         boxD = smooth(l.accD, l.gw, l.gh, 1, l.sigmaX(sc), l.sigmaY(sc), boxD);

@@ -340,10 +340,13 @@ Image3f reconstructFromLayers(const MethodContext& ctx,
     // 0.94-1.19x, 1.06x on their geometric mean, à-trous's 0.93-1.07x, MC's 0.90-1.02x, 0.96x;
     // docs/layers.md, "More rays where a layer moves").
     const bool ownRadiance = std::all_of(surfaceLight.begin(), surfaceLight.end(), [](const Image3f* l) { return l == nullptr; });
-    // Across a layer's motion, where it moves along one axis, filtered light keeps the layer's
-    // grid crisp: there the grid's blur trades sharpness for noise the filters have mostly
-    // removed (LayerOptions::crispAcrossMotion; docs/layers.md, "Crisp across the motion").
-    lo.crispAcrossMotion = !ownRadiance;
+    // Across a layer's motion, where it moves along one axis, its grid's coverage is crisp, and
+    // where the samples carry filtered light its radiance too: there the grid's blur trades
+    // sharpness for noise the filters have mostly removed, while a sample's own light keeps
+    // the plain Gaussian across the motion (LayerOptions::crispAcrossMotion, crispRadiance;
+    // docs/layers.md, "Crisp across the motion", "A crisp coverage for Monte Carlo's samples").
+    lo.crispAcrossMotion = true;
+    lo.crispRadiance = !ownRadiance;
     if (ownRadiance) {
         const double perPixel = double(ctx.lightField->samples()) / double(std::max<size_t>(1, size_t(fb.width) * fb.height));
         lo.sharpShare = float(std::clamp(std::sqrt(perPixel / 64.0), 0.5, 1.0));
