@@ -1371,11 +1371,12 @@ void meanVectorGrid(const float* count, int cs, const float* sums, int ss, int g
                     std::vector<float>& grid) {
     const size_t cells = size_t(gw) * gh;
     grid.resize(cells * 2);
+    auto has = [&](size_t i) { return !(count[i * cs] < 0.05f); };
     float deviation = 0;
     bool any = false;
     for (size_t i = 0; i < cells; ++i) {
+        if (!has(i)) continue;
         const float n = count[i * cs];
-        if (n < 0.05f) continue;
         grid[2 * i] = sums[i * ss] / n, grid[2 * i + 1] = sums[i * ss + 1] / n;
         deviation = std::max(deviation, sqr(grid[2 * i] - fit.mean.x) + sqr(grid[2 * i + 1] - fit.mean.y));
         any = true;
@@ -1386,45 +1387,45 @@ void meanVectorGrid(const float* count, int cs, const float* sums, int ss, int g
     // one's along the row (its left one's where two are as near), then in a row without any the
     // nearest such row's (the upper where two are as near).
     std::vector<Vec2f> residual(any ? cells : 0);
-    std::vector<int> left(any ? size_t(gw) : 0), fromRow(any ? size_t(gh) : 0, -1);
-    auto has = [&](size_t i) { return !(count[i * cs] < 0.05f); };
+    std::vector<int> left(any ? size_t(gw) : 0), below(any ? size_t(gh) : 0, -1);
+    std::vector<uint8_t> rowHas(any ? size_t(gh) : 0, 0);
     for (int j = 0; any && j < gh; ++j) {
         const size_t row = size_t(j) * gw;
         int last = -1;
         for (int i = 0; i < gw; ++i) {
-            if (has(row + i)) last = i;
+            if (has(row + i)) {
+                const Vec2f f = fitAt(row + i);
+                residual[row + i] = {grid[2 * (row + i)] - f.x, grid[2 * (row + i) + 1] - f.y};
+                last = i;
+            }
             left[size_t(i)] = last;
         }
         if (last < 0) continue;
-        fromRow[size_t(j)] = j;
-        int next = -1;
-        for (int i = gw - 1; i >= 0; --i) {
-            if (has(row + i)) next = i;
-            const int l = left[size_t(i)];
-            const size_t from = row + size_t(l >= 0 && (next < 0 || i - l <= next - i) ? l : next);
-            const Vec2f f = fitAt(from);
-            residual[row + i] = {grid[2 * from] - f.x, grid[2 * from + 1] - f.y};
-        }
-    }
-    if (any) {
-        int above = -1;
-        std::vector<int> below(size_t(gh), -1);
-        for (int j = gh - 1, next = -1; j >= 0; --j) {
-            if (fromRow[size_t(j)] == j) next = j;
-            below[size_t(j)] = next;
-        }
-        for (int j = 0; j < gh; ++j) {
-            if (fromRow[size_t(j)] == j) {
-                above = j;
+        rowHas[size_t(j)] = 1;
+        for (int i = gw - 1, next = -1; i >= 0; --i) {
+            if (has(row + i)) {
+                next = i;
                 continue;
             }
-            const int b = below[size_t(j)];
-            const int from = above >= 0 && (b < 0 || j - above <= b - j) ? above : b;
-            std::copy_n(&residual[size_t(from) * gw], gw, &residual[size_t(j) * gw]);
+            const int l = left[size_t(i)];
+            residual[row + i] = residual[row + size_t(l >= 0 && (next < 0 || i - l <= next - i) ? l : next)];
         }
     }
+    for (int j = gh - 1, next = -1; any && j >= 0; --j) {
+        if (rowHas[size_t(j)]) next = j;
+        below[size_t(j)] = next;
+    }
+    for (int j = 0, above = -1; any && j < gh; ++j) {
+        if (rowHas[size_t(j)]) {
+            above = j;
+            continue;
+        }
+        const int b = below[size_t(j)];
+        const int from = above >= 0 && (b < 0 || j - above <= b - j) ? above : b;
+        std::copy_n(&residual[size_t(from) * gw], gw, &residual[size_t(j) * gw]);
+    }
     for (size_t i = 0; i < cells; ++i) {
-        if (!(count[i * cs] < 0.05f)) continue;
+        if (has(i)) continue;
         const Vec2f v = fitAt(i);
         const Vec2f r = any ? residual[i] : Vec2f{0.f, 0.f};
         grid[2 * i] = v.x + r.x, grid[2 * i + 1] = v.y + r.y;
@@ -2289,11 +2290,14 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                     return (std::abs(l.c) + chordReach(l.depthRate) * l.motionRms) / float(step) + 3.f * sigmaIn(l, step);
                 };
                 // ... along x and along y apart: the lens's disc and the Gaussian both ways, the
-                // motion as far as it goes along each (a still layer's, both reachIn).
+                // motion as far as it goes along each (a still layer's, whose samples move less
+                // than a pixel, within reachIn both ways).
                 auto reachAxes = [&](const Layer& l, int step) {
                     const float k = chordReach(l.depthRate), s3 = 3.f * sigmaIn(l, step);
                     return Vec2f{(std::abs(l.c) + k * l.motionRmsX) / float(step) + s3, (std::abs(l.c) + k * l.motionRmsY) / float(step) + s3};
                 };
+                // A grid's margin beyond its tile (cells) for a reach of r cells.
+                auto marginOf = [](float r) { return int(std::ceil(r)) + 1; };
                 // The most cells a grid may have: a still layer's (or a moving one's) that reaches
                 // maxGridMargin beyond its tile both ways.
                 const float maxCells = sqr(float(o.tile + 2 * o.maxGridMargin));
@@ -2311,7 +2315,7 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                         // its pixels' own samples, and so did motion of 282 px, docs/motion.json
                         // rendered at 1024x1024; docs/layers.md, "A moving layer's grid per axis".)
                         const Vec2f r = reachAxes(l, 1);
-                        const float cells = (float(o.tile) + 2.f * (std::ceil(r.x) + 1.f)) * (float(o.tile) + 2.f * (std::ceil(r.y) + 1.f));
+                        const float cells = float(o.tile + 2 * marginOf(r.x)) * float(o.tile + 2 * marginOf(r.y));
                         return cells <= maxCells ? 1 : 0;
                     }
                     const float bound = float(std::min(o.maxGridMargin, o.stillGridReach)) - 1.f;
@@ -2383,8 +2387,8 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                         const float gridBlur = sqr(float(l.step)) * (kCellBlur + sqr(l.sigmaCoverage));  // (pixels^2)
                         l.gridBlur = l.lensBlur = gridBlur;
                         l.shapeRays(motion);
-                        lmx = int(std::ceil(gridReach.x)) + 1;  // (within stepOf's bound: above)
-                        lmy = int(std::ceil(gridReach.y)) + 1;
+                        lmx = marginOf(gridReach.x);  // (within stepOf's bound: above)
+                        lmy = marginOf(gridReach.y);
                         anyBlurred = true;
                     }
                     // (In cells; with a step of 1, X0 - lmx to X1 + lmx.)
