@@ -44,6 +44,9 @@ constexpr float kSlopeSpread = 0.25f;
 /// +2% and 0.5 +1% and +0.5%; below 0.75 docs/moving-boxes.json lost all of its gain, its box's
 /// slopes reaching 0.7 px: docs/layers.md, "Crisp across the motion".)
 constexpr float kCrispMotion = 0.25f, kCrispSlope = 0.75f;
+// The largest cells (pixels a side) of a moving layer's grid (LayerOptions::maxGridMargin); a
+// layer that needs larger ones fits in no grid.
+constexpr int kMaxMovingStep = 8;
 /// A sample's screen motion counts as motion above this (pixels over the shutter).
 constexpr float kMoving = 0.5f;
 /// A tile's moving samples fall in at most this many groups of like motion, each split into
@@ -453,7 +456,10 @@ struct Layer {
     // layer whose blur would take its grid more than LayerOptions::stillGridReach pixels beyond
     // its tile: there it is `step` pixels a side, the fewest that keep the grid within that many
     // cells (its sigmas are in cells, and its own blur, gridBlur, step^2 times a 1-px grid's:
-    // "Blur past the grid's reach" in docs/layers.md).
+    // "Blur past the grid's reach" in docs/layers.md); and in a moving layer whose grid of 1-px
+    // cells would have more than LayerOptions::maxGridMargin allows, the fewest pixels that fit
+    // (the motion grid's fits are in pixels all the same, inPixels; no crisp axis on such
+    // cells: "Larger cells for a long motion").
     int gx0 = 0, gy0 = 0, gw = 0, gh = 0;
     int step = 1;
     float invStep = 1.f;
@@ -1356,6 +1362,16 @@ AffineMotion fitMotion(const float* count, int cs, const float* sums, int ss, in
     return fit;
 }
 
+/// fitMotion's fit of layer l's grid (its cells' positions from the grid's corner, in cells) in
+/// the image's pixels, as the rays and the D pass read it (motionShift).
+AffineMotion inPixels(const AffineMotion& f, const Layer& l) {
+    AffineMotion p = f;
+    const float step = float(l.step), inv = l.invStep;
+    p.centre = {(f.centre.x + float(l.gx0)) * step, (f.centre.y + float(l.gy0)) * step};
+    p.b00 = f.b00 * inv, p.b01 = f.b01 * inv, p.b10 = f.b10 * inv, p.b11 = f.b11 * inv;
+    return p;
+}
+
 /// A layer's grid of mean 2-vectors (motionGrid, sagGrid: x and y per cell) from its smoothed
 /// counts and sums (as fitMotion reads them): a cell's mean where its count is at least 0.05,
 /// else (no samples there) `fit` at the cell, within the largest distance from the fit's mean
@@ -1674,8 +1690,9 @@ void motionCells(const Layer& l, const int* occupied, int margin, MotionBatch& b
         const float qx = b.qx[j], qy = b.qy[j], dt = alongChord(b.t[j] - 0.5f, l.depthRate);
         const float r = std::abs(dt) * l.maxMotion + (kCurved ? l.maxSag : 0.f) + 1.f;
         const float d = b.t[j] - 0.5f, k = 4.f * d * d;  // (kCurved)
-        const int i0 = int(std::floor(qx - r)) - l.gx0 - margin, i1 = int(std::floor(qx + r)) - l.gx0 + margin;
-        const int j0 = int(std::floor(qy - r)) - l.gy0 - margin, j1 = int(std::floor(qy + r)) - l.gy0 + margin;
+        const float inv = l.invStep;
+        const int i0 = int(std::floor((qx - r) * inv)) - l.gx0 - margin, i1 = int(std::floor((qx + r) * inv)) - l.gx0 + margin;
+        const int j0 = int(std::floor((qy - r) * inv)) - l.gy0 - margin, j1 = int(std::floor((qy + r) * inv)) - l.gy0 + margin;
         // The rectangle clamped to the grid (empty where it misses the grid).
         const int a0 = minValue(gw, maxValue(0, i0)), a1 = minValue(gw, maxValue(0, i1 + 1));
         const int c0 = minValue(gh, maxValue(0, j0)), c1 = minValue(gh, maxValue(0, j1 + 1));
@@ -1693,7 +1710,7 @@ void motionCells(const Layer& l, const int* occupied, int margin, MotionBatch& b
             py = qy - m2.y * dt + k * e2.y;
         }
         // (gridCell's cell, with its tests as one mask for the SIMD loop.)
-        const int ci = int(std::floor(px)) - l.gx0, cj = int(std::floor(py)) - l.gy0;
+        const int ci = int(std::floor(px * inv)) - l.gx0, cj = int(std::floor(py * inv)) - l.gy0;
         const int counts = int(unsigned(ci) < unsigned(gw)) & int(unsigned(cj) < unsigned(gh)) & int(samples > 0);
         b.cell[j] = counts ? cj * gw + ci : -1;
     }
@@ -2303,8 +2320,8 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                 const float maxCells = sqr(float(o.tile + 2 * o.maxGridMargin));
                 // The cell size that keeps a layer's grid within LayerOptions::stillGridReach
                 // cells of its tile (a still layer) or within maxCells (a moving one): 1 pixel,
-                // or for a still layer past that the fewest pixels that do; 0 where none will (a
-                // moving layer, whose motion grid, time bins and motion fits are a 1-px grid's).
+                // or past that the fewest pixels that do (a moving layer's at most
+                // kMaxMovingStep); 0 where none will.
                 auto stepOf = [&](const Layer& l) {
                     if (l.moving) {
                         // A moving layer's grid reaches along each axis as far as its motion
@@ -2314,9 +2331,19 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                         // motion's length, bounded by maxGridMargin: a sphere moving 264 px kept
                         // its pixels' own samples, and so did motion of 282 px, docs/motion.json
                         // rendered at 1024x1024; docs/layers.md, "A moving layer's grid per axis".)
-                        const Vec2f r = reachAxes(l, 1);
-                        const float cells = float(o.tile + 2 * marginOf(r.x)) * float(o.tile + 2 * marginOf(r.y));
-                        return cells <= maxCells ? 1 : 0;
+                        // Past that its cells are larger, as a still layer's: a motion along a
+                        // diagonal, a dolly's near walls, blurs along itself far more than a cell.
+                        // (Before, a motion of more than about 250 px along each axis fitted in
+                        // no grid: on docs/sponza-dolly.json a quarter of the image kept its
+                        // pixels' own samples; docs/layers.md, "Larger cells for a long motion".)
+                        for (int step = 1; step <= kMaxMovingStep; ++step) {
+                            const Vec2f r = reachAxes(l, step);
+                            // (A tile's cells: with cells of `step` pixels that do not divide
+                            // it, one more.)
+                            const int tileCells = step == 1 ? o.tile : (o.tile + step - 1) / step + 1;
+                            if (float(tileCells + 2 * marginOf(r.x)) * float(tileCells + 2 * marginOf(r.y)) <= maxCells) return step;
+                        }
+                        return 0;
                     }
                     const float bound = float(std::min(o.maxGridMargin, o.stillGridReach)) - 1.f;
                     if (reachIn(l, 1) <= bound) return 1;
@@ -2449,7 +2476,7 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                     std::vector<std::array<float, 2>> most(layers.size(), {-1.f, -1.f});
                     for (size_t k = 0; k < layers.size(); ++k) {
                         const Layer& l = layers[k];
-                        if (!motionAcc[k].empty() && std::max(std::abs(l.cMin), std::abs(l.cMax)) <= kCrispSlope) most[k] = {0.f, 0.f};
+                        if (!motionAcc[k].empty() && l.step == 1 && std::max(std::abs(l.cMin), std::abs(l.cMax)) <= kCrispSlope) most[k] = {0.f, 0.f};
                     }
                     for (const Gathered& s : g) {
                         std::array<float, 2>& m = most[size_t(split.layerOf(s))];
@@ -2634,14 +2661,12 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                         Layer& l = layers[k];
                         const float* sums = motionAcc[k].data();  // (per cell: count, sum of mx, sum of my)
                         const AffineMotion fit = fitMotion(sums, 3, sums + 1, 3, l.gw, l.gh, Vec2f{l.mx, l.my});
-                        l.motionFit = fit;
-                        l.motionFit.centre = {fit.centre.x + float(l.gx0), fit.centre.y + float(l.gy0)};
+                        l.motionFit = inPixels(fit, l);
                         // (A turning layer's effective sagittas fitted likewise, over the same count,
                         // before the sums are smoothed.)
                         const bool turning = !sagAcc[k].empty();
                         const AffineMotion sagFit = turning ? fitMotion(sums, 3, sagAcc[k].data(), 2, l.gw, l.gh, Vec2f{0.f, 0.f}) : AffineMotion{};
-                        l.sagFit = sagFit;
-                        l.sagFit.centre = {sagFit.centre.x + float(l.gx0), sagFit.centre.y + float(l.gy0)};
+                        l.sagFit = inPixels(sagFit, l);
                         // The mean motion per cell, and where the layer turns the mean effective
                         // sagitta, the sums smoothed alike and over the same (smoothed) count.
                         const CellBox counted = o.everyCell ? CellBox{0, 0, l.gw, l.gh} : nonZeroBox(motionAcc[k], l.gw, l.gh, 3);  // (its N's cells)
@@ -2711,11 +2736,14 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                         const int m = dMargin(l);
                         margin[size_t(k)] = m;
                         // (motionCells' r is at most |dt| maxMotion + 1, |dt| at most chordReach; a cell to spare.)
-                        const float reach = float(m) + chordReach(l.depthRate) * l.maxMotion + l.maxSag + 2.f;
+                        // (In pixels: the cells' edges are multiples of the layer's step.)
+                        const float step = float(l.step);
+                        const float reach = float(m) * step + chordReach(l.depthRate) * l.maxMotion + l.maxSag + 2.f;
                         if (bx1 >= 0) {
-                            reachBox[size_t(k)] = {float(l.gx0 + bx0) - reach, float(l.gy0 + by0) - reach, float(l.gx0 + bx1 + 1) + reach,
-                                                   float(l.gy0 + by1 + 1) + reach};
-                            ownBox[size_t(k)] = {float(l.gx0 + bx0 - m), float(l.gy0 + by0 - m), float(l.gx0 + bx1 + 1 + m), float(l.gy0 + by1 + 1 + m)};
+                            reachBox[size_t(k)] = {float(l.gx0 + bx0) * step - reach, float(l.gy0 + by0) * step - reach,
+                                                   float(l.gx0 + bx1 + 1) * step + reach, float(l.gy0 + by1 + 1) * step + reach};
+                            ownBox[size_t(k)] = {float(l.gx0 + bx0 - m) * step, float(l.gy0 + by0 - m) * step, float(l.gx0 + bx1 + 1 + m) * step,
+                                                 float(l.gy0 + by1 + 1 + m) * step};
                         }
                         batch[size_t(k)].n = 0;
                     }

@@ -105,12 +105,13 @@ struct LayerOptions {
     int tile = 64;             // pixels
     int maxReach = 48;         // pixels: a tile gathers the samples whose trajectories reach it from at most this far (the cost bound)
     // cells: a blurred layer's grid has at most the cells of one reaching this far beyond its
-    // tile both ways (its memory: (64 + 2 x 128)^2 cells). A moving layer's cells are pixels and
-    // its grid reaches along each axis as far as its blur there, |c| + |m_x| / 2 + 3 sigma
-    // across and |c| + |m_y| / 2 + 3 sigma down (an in-focus streak along x up to about 700 px
-    // along it, a motion of 1400 px, and 3 across); a tile with a moving layer whose grid
-    // would have more cells reconstructs no layer (each keeps its pixels' own samples, as
-    // without layers: layers.cpp, tileBeyondGrid).
+    // tile both ways (its memory: (64 + 2 x 128)^2 cells). A moving layer's grid reaches along
+    // each axis as far as its blur there, |c| + |m_x| / 2 + 3 sigma across and |c| + |m_y| / 2
+    // + 3 sigma down, on cells of 1 px where that fits (an in-focus streak along x of up to
+    // 1400 px, a diagonal one of about 250 px along each axis) and past it on larger cells, up
+    // to 8 px (Layer::step: a diagonal motion of about 2400 px along each axis); a tile with a
+    // moving layer that fits on none reconstructs no layer (each keeps its pixels' own samples,
+    // as without layers: layers.cpp, tileBeyondGrid).
     int maxGridMargin = 128;
     // cells: a blurred still layer's grid reaches at most this far beyond its tile: where its
     // blur would take a grid of 1-px cells farther, its cells are larger (Layer::step), so that
