@@ -1547,18 +1547,35 @@ struct Rays {
     return solveShift(a00, a01, a10, a11, rx, ry, qx, qy, fallback);
 }
 
-/// Rays [j0, j1) through a blurred layer (the `index`-th a pixel's rays see): the layer's lens
-/// and shutter shear, then (kFollow) the slope of the surface found there, shaped by the grid's
-/// blur, and the layer's alpha and premultiplied light there (kMoving: between its two nearest
-/// time bins) composited under what is in front, C += T alpha L, T *= 1 - alpha, for the rays
-/// not yet stopped (T >= 1e-4). Per ray the arithmetic of the scalar loop it replaced, in the
-/// same order, as one SIMD loop (its images the same to float rounding, docs/layers.md): every
-/// lane is computed, and a stopped ray's results are not stored. Returns whether a ray took
-/// part of the layer's coverage.
+/// What rays [j0, j1) find on one layer: per ray its alpha and premultiplied light there,
+/// before they are composited (compositeTaken).
+struct Taken {
+    alignas(64) float alpha[Rays::kMax], r[Rays::kMax], g[Rays::kMax], b[Rays::kMax];
+};
+
+/// Rays [j0, j1) composited under layer `index`'s alpha and light as `taken` holds them
+/// (composite, ray by ray). Returns whether a ray took part of the layer's coverage.
+bool compositeTaken(Rays& ray, int index, const Taken& taken, int j0, int j1) {
+    int partial = 0;
+#pragma omp simd reduction(| : partial)
+    for (int j = j0; j < j1; ++j) partial |= composite(ray, j, index, taken.alpha[j], taken.r[j], taken.g[j], taken.b[j]);
+    return partial != 0;
+}
+
+/// Rays [j0, j1) through a blurred layer: the layer's lens and shutter shear, then (kFollow)
+/// the slope of the surface found there, shaped by the grid's blur, and the layer's alpha and
+/// premultiplied light there (kMoving: between its two nearest time bins), into `taken`, for
+/// compositeTaken to put under what is in front. Per ray the arithmetic of the scalar loop it
+/// replaced, in the same order, as one SIMD loop (its images the same to float rounding,
+/// docs/layers.md): every lane is computed, a stopped ray's too.
+/// (Apart from compositing, since rays whose layers change order over the shutter are
+/// composited per order bin, a few rays each: traced there a bin at a time, the loop ran its
+/// scalar remainder, and on 400 small spheres moving every way the stage took 11x the
+/// sampling's time; docs/layers.md, "Rays traced once per layer where the order changes".)
 /// (kGrid: the layer has a motion grid, followed as above; a template parameter, since a
 /// runtime condition in the loop left its lookups masked, and GCC kept such loops scalar.)
 template <bool kFollow, bool kMoving, bool kGrid, bool kCurved>
-bool traceBlurredRays(const Layer& l, int index, Rays& ray, int j0, int j1, const Blend& own) {
+void traceBlurredRays(const Layer& l, const Rays& ray, int j0, int j1, const Blend& own, Taken& taken) {
     const int cs = l.cellStride(), bins = l.timeBins;
     const float ownW = own.w, ownA = own.alpha, ownR = own.r, ownG = own.g, ownB = own.b;
     const float* cell = l.cell.data();
@@ -1570,8 +1587,11 @@ bool traceBlurredRays(const Layer& l, int index, Rays& ray, int j0, int j1, cons
     float shearA[Layer::kShearSteps + 1], shearB[Layer::kShearSteps + 1];
     for (int i = 0; i <= Layer::kShearSteps; ++i) shearA[i] = l.shearTable[i].a, shearB[i] = l.shearTable[i].b;
     const AffineMotion fit = l.motionFit, sagFit = l.sagFit;
-    int partial = 0;
-#pragma omp simd reduction(| : partial)
+    float* takenAlpha = taken.alpha;
+    float* takenR = taken.r;
+    float* takenG = taken.g;
+    float* takenB = taken.b;
+#pragma omp simd
     for (int j = j0; j < j1; ++j) {
         const float dt = ray.dt[j];
         const float shaped = dt * (1.f + l.rayT2 * 4.f * dt * dt);
@@ -1652,16 +1672,18 @@ bool traceBlurredRays(const Layer& l, int index, Rays& ray, int j0, int j1, cons
                 bl += cell[c0 + 2] * w;
             }
         }
-        partial |= composite(ray, j, index, alpha * ownW + ownA, r * ownW + ownR, g * ownW + ownG, bl * ownW + ownB);
+        takenAlpha[j] = alpha * ownW + ownA;
+        takenR[j] = r * ownW + ownR;
+        takenG[j] = g * ownW + ownG;
+        takenB[j] = bl * ownW + ownB;
     }
-    return partial != 0;
 }
 template <bool kFollow, bool kMoving, bool kCurved = false>
-bool traceBlurred(const Layer& l, int index, Rays& ray, int j0, int j1, const Blend& own) {
+void traceBlurred(const Layer& l, const Rays& ray, int j0, int j1, const Blend& own, Taken& taken) {
     if constexpr (kMoving) {
-        if (!l.motionGrid.empty()) return traceBlurredRays<kFollow, true, true, kCurved>(l, index, ray, j0, j1, own);
+        if (!l.motionGrid.empty()) return traceBlurredRays<kFollow, true, true, kCurved>(l, ray, j0, j1, own, taken);
     }
-    return traceBlurredRays<kFollow, kMoving, false, false>(l, index, ray, j0, j1, own);
+    traceBlurredRays<kFollow, kMoving, false, false>(l, ray, j0, j1, own, taken);
 }
 
 /// Samples behind a layer with a motion grid, for its D (the D pass of reconstructLayers): each
@@ -2872,6 +2894,10 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                 std::vector<Active> active;
                 std::vector<int> binActive;  // (timeOrder) per order bin, `active` in its order
                 Rays ray, sorted;
+                // The alpha and light each of a pixel's active layers gives its rays (traceBlurred),
+                // and whether they are there yet (where its layers change order over the shutter).
+                std::vector<Taken> taken(1);
+                std::vector<uint8_t> isTaken;
                 // The rays' sequence before each pixel's shift: (j + 1) k_d modulo 1.
                 alignas(64) float kron[5][Rays::kMax];  // (by dimension: the rays' SIMD loop below reads them as vectors)
                 const int rays = anyBlurred ? std::clamp(o.rays, 1, Rays::kMax) : 1;
@@ -2974,11 +3000,31 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                         // Whether the rays straddle layers: one ended on another layer than the
                         // first ray, or took part of a layer's coverage.
                         bool partial = false;
+                        // A blurred layer's alpha and light for rays [j0, j1): its shear, then the
+                        // slope of the surface it finds there (one fixed-point step), shaped by
+                        // the grid's blur.
+                        auto traceLayer = [&](const Active& a, int j0, int j1, Taken& t) {
+                            const Layer& l = *a.layer;
+                            const bool follow = l.followsSlope(), moving = l.timeBins > 1;
+                            const bool arcs = moving && !l.sagGrid.empty() && !l.motionGrid.empty();
+                            const Blend& bl = a.blend;
+                            if (arcs)
+                                follow ? traceBlurred<true, true, true>(l, ray, j0, j1, bl, t) : traceBlurred<false, true, true>(l, ray, j0, j1, bl, t);
+                            else if (follow)
+                                moving ? traceBlurred<true, true>(l, ray, j0, j1, bl, t) : traceBlurred<true, false>(l, ray, j0, j1, bl, t);
+                            else
+                                moving ? traceBlurred<false, true>(l, ray, j0, j1, bl, t) : traceBlurred<false, false>(l, ray, j0, j1, bl, t);
+                        };
                         // Rays [j0, j1) through the layers they can see, front to back: in the
-                        // tile's order, or (activeOrder) in that of an order bin.
-                        auto traceLayers = [&](int j0, int j1, const int* activeOrder) {
+                        // tile's order, or (activeOrder) in that of an order bin. With `all`,
+                        // rays all[0] to all[1] of which [j0, j1) are one bin's: a blurred
+                        // layer is traced for all of them the first time one bin's rays reach
+                        // it (a bin's few rays would run the SIMD loop's scalar remainder), its
+                        // alpha and light kept in taken[its index in active] for the others.
+                        auto traceLayers = [&](int j0, int j1, const int* activeOrder, const int* all) {
                             for (size_t i = 0; i < active.size(); ++i) {
-                                const Active& a = active[activeOrder ? size_t(activeOrder[i]) : i];
+                                const size_t index = activeOrder ? size_t(activeOrder[i]) : i;
+                                const Active& a = active[index];
                                 // Once every ray has stopped (T < 1e-4) the layers behind add
                                 // nothing (composite stores nothing for a stopped ray): the
                                 // same image, without their lookups.
@@ -2987,24 +3033,20 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                                 if (!live) break;
                                 if (a.skip) continue;
                                 const Layer& l = *a.layer;
-                                const int index = int(&a - active.data());
                                 auto take = [&](int j, const Lookup& v) {
-                                    partial |= composite(ray, j, index, v.alpha, v.premultiplied.x, v.premultiplied.y, v.premultiplied.z) != 0;
+                                    partial |= composite(ray, j, int(index), v.alpha, v.premultiplied.x, v.premultiplied.y, v.premultiplied.z) != 0;
                                 };
                                 if (a.fixed) {
                                     for (int j = j0; j < j1; ++j) take(j, a.value);
                                 } else if (l.sharp) {  // a sharp layer is its pixels' own samples: the ray's pixel
                                     for (int j = j0; j < j1; ++j)
                                         if (ray.trans[j] >= 1e-4f) take(j, lookupSharp(l, x, y, ray.dt[j] + 0.5f));
+                                } else if (!all) {
+                                    traceLayer(a, j0, j1, taken[0]);
+                                    partial |= compositeTaken(ray, int(index), taken[0], j0, j1);
                                 } else {
-                                    // The layer's shear, then the slope of the surface it finds
-                                    // there (one fixed-point step), shaped by the grid's blur.
-                                    const bool follow = l.followsSlope(), moving = l.timeBins > 1;
-                                    const bool arcs = moving && !l.sagGrid.empty() && !l.motionGrid.empty();
-                                    const Blend& bl = a.blend;
-                                    partial |= arcs ? (follow ? traceBlurred<true, true, true>(l, index, ray, j0, j1, bl) : traceBlurred<false, true, true>(l, index, ray, j0, j1, bl))
-                                             : follow ? (moving ? traceBlurred<true, true>(l, index, ray, j0, j1, bl) : traceBlurred<true, false>(l, index, ray, j0, j1, bl))
-                                                      : (moving ? traceBlurred<false, true>(l, index, ray, j0, j1, bl) : traceBlurred<false, false>(l, index, ray, j0, j1, bl));
+                                    if (!isTaken[index]) traceLayer(a, all[0], all[1], taken[index]), isTaken[index] = 1;
+                                    partial |= compositeTaken(ray, int(index), taken[index], j0, j1);
                                 }
                             }
                         };
@@ -3040,7 +3082,7 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                                     r.hit[j] = -1;
                                 }
                             }
-                            if (reorderedActive < 2 || sameOrder) return traceLayers(j0, j1, reorderedActive >= 2 ? binActive.data() : nullptr);
+                            if (reorderedActive < 2 || sameOrder) return traceLayers(j0, j1, reorderedActive >= 2 ? binActive.data() : nullptr, nullptr);
                             // Where the order of the layers the pixel's rays see changes over the
                             // shutter, the rays are grouped by their time's bin (a stable counting
                             // sort: which ray is where does not change their mean), each group
@@ -3059,11 +3101,16 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                                 ray.ux[j] = sorted.ux[j], ray.uy[j] = sorted.uy[j], ray.u2[j] = sorted.u2[j];
                                 ray.px[j] = sorted.px[j], ray.py[j] = sorted.py[j], ray.dt[j] = sorted.dt[j];
                             }
+                            // Each blurred layer traced for all of them at once, then composited
+                            // bin by bin: the same arithmetic per ray.
                             const size_t na = active.size();
+                            if (taken.size() < na) taken.resize(na);
+                            isTaken.assign(na, 0);
+                            const int all[2] = {j0, j1};
                             for (int b = 0; b < kOrderBins;) {
                                 int e = b + 1;
                                 while (e < kOrderBins && std::equal(&binActive[size_t(e) * na], &binActive[size_t(e) * na] + na, &binActive[size_t(b) * na])) ++e;
-                                if (first[e] > first[b]) traceLayers(j0 + first[b], j0 + first[e], &binActive[size_t(b) * na]);
+                                if (first[e] > first[b]) traceLayers(j0 + first[b], j0 + first[e], &binActive[size_t(b) * na], all);
                                 b = e;
                             }
                         };
