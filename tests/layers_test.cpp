@@ -677,8 +677,8 @@ TEST(Layers, AMotionOf1500PixelsIsReconstructedOnLargerCells) {
     // the layer's cells are 2 px (Layer::step), and it is reconstructed. (Before, no layer of
     // its tiles was reprojected and their pixels kept their own samples: Monte Carlo's squared
     // error exactly, worst column 0.018. Measured now: 0.42x Monte Carlo's, worst column 0.012;
-    // less of a gain than the 297-px strip's, since a tile gathers the samples of its pixels
-    // and LayerOptions::maxReach beyond them, a tenth of the trail's.)
+    // less of a gain than the 297-px strip's for the rays' own noise over the shutter: the strip
+    // covers each pixel for 3% of it, 2 of Monte Carlo's 64 reconstruction rays.)
     const ColumnErrors e = movingStripErrors(65.6f, 128, 1600, -34.f, 2.f);
     EXPECT_LT(e.worstColumn, 0.03) << "the largest difference of a column's mean, of the strip's radiance";
     EXPECT_LT(e.squaredOn, 0.6 * e.squaredOff) << "the layers' squared error against the Monte Carlo estimate's";

@@ -1706,13 +1706,13 @@ struct MotionBatch {
 template <bool kCurved>
 void motionCells(const Layer& l, const int* occupied, int margin, MotionBatch& b) {
     const int gw = l.gw, gh = l.gh, ow = gw + 1, n = b.n;
+    const float inv = l.invStep;  // (pixels to cells)
     const AffineMotion fit = l.motionFit, sagFit = l.sagFit;
 #pragma omp simd
     for (int j = 0; j < n; ++j) {
         const float qx = b.qx[j], qy = b.qy[j], dt = alongChord(b.t[j] - 0.5f, l.depthRate);
         const float r = std::abs(dt) * l.maxMotion + (kCurved ? l.maxSag : 0.f) + 1.f;
         const float d = b.t[j] - 0.5f, k = 4.f * d * d;  // (kCurved)
-        const float inv = l.invStep;
         const int i0 = int(std::floor((qx - r) * inv)) - l.gx0 - margin, i1 = int(std::floor((qx + r) * inv)) - l.gx0 + margin;
         const int j0 = int(std::floor((qy - r) * inv)) - l.gy0 - margin, j1 = int(std::floor((qy + r) * inv)) - l.gy0 + margin;
         // The rectangle clamped to the grid (empty where it misses the grid).
