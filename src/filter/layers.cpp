@@ -367,6 +367,16 @@ struct Layer {
     // ... and its x and y components' (a layer's grid reaches along each axis as far as its motion
     // there: reachAxes in reconstructLayers).
     float motionRmsX = 0, motionRmsY = 0;
+    // The largest |x| and |y| of its samples' motion and of their sagittas: how far from its sharp
+    // image along each axis a ray at the shutter's ends may look, where the layer turns (its
+    // samples carry sagittas; reachAxes in reconstructLayers). A turn's motion grows with the
+    // distance from its pivot, so its tips' is the largest, well past the root mean square: a fan
+    // turning 90 degrees had its grid end short of its blades' tips, and the rays there read the
+    // grid's clamped edge, which filled 64-px boxes outside the disc it sweeps with the tips'
+    // colour (docs/layers.md, "A turning fan's tips"). Elsewhere the root mean square stays:
+    // the largest measured 10-28% more stage time on docs/sponza-dolly.json and turning-room.json
+    // for the same or 3% higher relMSE (there a clamped edge continues a large surface).
+    Vec2f motionMax{}, sagMax{};
     // The rays' shear, shaped by the grid's own blur (Shaped): a ray at lens point u (unit disc)
     // is sheared by (rayC + rayC2 |u|^2) u, one at time t by (1 + rayT2 (2 s)^2) s rayM, s = t -
     // 1/2. A ray that takes the slope c of the surface it finds is sheared by (A(c) + B(c)
@@ -529,6 +539,7 @@ struct Split {
         std::vector<int> count, binLayer;
         std::vector<double> sumC, sumMx, sumMy, sumM2, sumMx2, sumInvDepth;
         std::vector<float> cMin, cMax, invMax, invMin;
+        std::vector<Vec2f> motionMax, sagMax;
         std::vector<uint8_t> sharpRun;  // per layer of the class: a merged run of sharp layers
         float invBinW = 0;  // 1 / binW where that is exact (binW a power of two, as the least, 0.25, is), else 0
         int bin(float c) const { return std::clamp(int(invBinW > 0.f ? (cHi - c) * invBinW : (cHi - c) / binW), 0, bins - 1); }
@@ -556,6 +567,8 @@ void addBin(Layer& l, const Split::Histogram& h, int b) {
     l.cMax = std::max(l.cMax, h.cMax[b]);
     l.invDepthMax = std::max(l.invDepthMax, h.invMax[b]);
     l.invDepthMin = std::min(l.invDepthMin, h.invMin[b]);
+    l.motionMax = vmax(l.motionMax, h.motionMax[b]);
+    l.sagMax = vmax(l.sagMax, h.sagMax[b]);
 }
 
 /// What a tile's samples are split into layers by (splitLayers): their defocus slope, which falls
@@ -890,6 +903,8 @@ void splitLayers(Samples& g, const SlopeRange (&range)[kClasses], const float (&
         h.cMax.assign(h.bins, -kInf);
         h.invMax.assign(h.bins, 0.f);
         h.invMin.assign(h.bins, kInf);
+        h.motionMax.assign(h.bins, Vec2f{});
+        h.sagMax.assign(h.bins, Vec2f{});
     }
     // Consecutive samples mostly fall in one bin (a pixel's, its neighbour's: one surface), so
     // each class sums its current run of one bin in registers and adds the run to the bin when
@@ -898,6 +913,7 @@ void splitLayers(Samples& g, const SlopeRange (&range)[kClasses], const float (&
         int bin = -1, count = 0;
         double c = 0, mx = 0, my = 0, m2 = 0, mx2 = 0, invDepth = 0;
         float cMin = kInf, cMax = -kInf, invMax = 0, invMin = kInf;
+        Vec2f motionMax{}, sagMax{};
     };
     Run run[kClasses];
     auto flush = [&](int cls) {
@@ -915,6 +931,8 @@ void splitLayers(Samples& g, const SlopeRange (&range)[kClasses], const float (&
         h.cMax[r.bin] = std::max(h.cMax[r.bin], r.cMax);
         h.invMax[r.bin] = std::max(h.invMax[r.bin], r.invMax);
         h.invMin[r.bin] = std::min(h.invMin[r.bin], r.invMin);
+        h.motionMax[r.bin] = vmax(h.motionMax[r.bin], r.motionMax);
+        h.sagMax[r.bin] = vmax(h.sagMax[r.bin], r.sagMax);
         r = Run{};
     };
     // (With still samples alone, as in a tile without motion, the class is 0 for every sample:
@@ -940,6 +958,8 @@ void splitLayers(Samples& g, const SlopeRange (&range)[kClasses], const float (&
             r.cMax = std::max(r.cMax, s.c);
             r.invMax = std::max(r.invMax, s.invDepth);
             r.invMin = std::min(r.invMin, s.invDepth);
+            r.motionMax = vmax(r.motionMax, Vec2f{std::abs(s.mx), std::abs(s.my)});
+            r.sagMax = vmax(r.sagMax, Vec2f{std::abs(s.sx), std::abs(s.sy)});
         }
     };
     bool stillOnly = true;
@@ -2333,7 +2353,11 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                 // than a pixel, within reachIn both ways).
                 auto reachAxes = [&](const Layer& l, int step) {
                     const float k = chordReach(l.depthRate), s3 = 3.f * sigmaIn(l, step);
-                    return Vec2f{(std::abs(l.c) + k * l.motionRmsX) / float(step) + s3, (std::abs(l.c) + k * l.motionRmsY) / float(step) + s3};
+                    // (A turning layer's as far as its farthest-moving samples: Layer::motionMax.)
+                    const bool turning = l.sagMax.x > 0.f || l.sagMax.y > 0.f;
+                    const float rx = turning ? k * l.motionMax.x + l.sagMax.x : k * l.motionRmsX;
+                    const float ry = turning ? k * l.motionMax.y + l.sagMax.y : k * l.motionRmsY;
+                    return Vec2f{(std::abs(l.c) + rx) / float(step) + s3, (std::abs(l.c) + ry) / float(step) + s3};
                 };
                 // A grid's margin beyond its tile (cells) for a reach of r cells.
                 auto marginOf = [](float r) { return int(std::ceil(r)) + 1; };
