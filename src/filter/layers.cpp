@@ -244,6 +244,32 @@ inline Vec2f curvedShift(Vec2f e, float t) {
     const float d = t - 0.5f, k = 4.f * d * d;
     return {k * e.x, k * e.y};
 }
+/// Arcs of a large turn. The parabola of curvedShift is the arc's limit for a small turn; a
+/// point turning at a steady rate by theta over the shutter is, at shutter offset d (its chord's
+/// pace a), A(a) m - B(d) e from its mid-shutter place, A(a) = sin(theta a) / (2 sin(theta/2)),
+/// B(d) = (1 - cos(theta d)) / (1 - cos(theta/2)): d and 4 d^2 as theta goes to 0, the same ends
+/// (m/2 - e), and along the chord the pace of the turn, not a steady one (at a quarter of a
+/// 90-degree turn 0.271 of the chord where the parabola puts it at 0.25). A turning layer's
+/// theta is its samples' (|e| / |m| = tan(theta/4) / 2, e across the chord), at most half a
+/// turn, and A and B are d sinc(theta d) / sinc(theta/2) and 4 d^2 f(theta d) / f(theta/2), f(x) =
+/// 2 (1 - cos x) / x^2, each a polynomial in (theta d)^2 to within 3e-6 (plain arithmetic, for
+/// the SIMD loops). (With the parabola the bars of docs/fan.json turning 90 degrees showed sectors
+/// 10% too bright or too dark winding with the turn: docs/layers.md, "Arcs of a large turn".)
+struct ArcPace {
+    float theta2 = 0, invSincHalf = 1, invBendHalf = 1;  // theta^2, 1 / sinc(theta/2), 1 / f(theta/2)
+    static float sinc(float u) { return 1.f - u * (1.f / 6 - u * (1.f / 120 - u * (1.f / 5040 - u * (1.f / 362880)))); }  // u = x^2
+    static float bend(float u) { return 1.f - u * (1.f / 12 - u * (1.f / 360 - u * (1.f / 20160 - u * (1.f / 1814400)))); }
+    /// For a turn of `theta` radians (0: the parabola's d and 4 d^2), at most half a turn.
+    void build(float theta) {
+        const float t = std::clamp(theta, 0.f, kPi);
+        theta2 = t * t;
+        invSincHalf = 1.f / sinc(0.25f * theta2);
+        invBendHalf = 1.f / bend(0.25f * theta2);
+    }
+    /// A(a) and B(d) (above).
+    [[gnu::always_inline]] float chord(float a) const { return a * sinc(theta2 * a * a) * invSincHalf; }
+    [[gnu::always_inline]] float arc(float d) const { return 4.f * d * d * bend(theta2 * d * d) * invBendHalf; }
+};
 /// The effective sagitta e of a sample in a layer of depth rate g (curvedShift).
 inline Vec2f effectiveSag(const Gathered& s, float g) { return {s.sx - 0.25f * g * s.mx, s.sy - 0.25f * g * s.my}; }
 inline bool curved(const Gathered& s) { return s.sx != 0.f || s.sy != 0.f; }
@@ -377,6 +403,10 @@ struct Layer {
     // the largest measured 10-28% more stage time on docs/sponza-dolly.json and turning-room.json
     // for the same or 3% higher relMSE (there a clamped edge continues a large surface).
     Vec2f motionMax{}, sagMax{};
+    // Its turning samples' summed |sagitta| and |motion| (the turn's angle: ArcPace) and the
+    // tables of their pace along their arcs.
+    double arcSag = 0, arcMotion = 0;
+    ArcPace arc;
     // The rays' shear, shaped by the grid's own blur (Shaped): a ray at lens point u (unit disc)
     // is sheared by (rayC + rayC2 |u|^2) u, one at time t by (1 + rayT2 (2 s)^2) s rayM, s = t -
     // 1/2. A ray that takes the slope c of the surface it finds is sheared by (A(c) + B(c)
@@ -540,6 +570,7 @@ struct Split {
         std::vector<double> sumC, sumMx, sumMy, sumM2, sumMx2, sumInvDepth;
         std::vector<float> cMin, cMax, invMax, invMin;
         std::vector<Vec2f> motionMax, sagMax;
+        std::vector<double> arcSag, arcMotion;
         std::vector<uint8_t> sharpRun;  // per layer of the class: a merged run of sharp layers
         float invBinW = 0;  // 1 / binW where that is exact (binW a power of two, as the least, 0.25, is), else 0
         int bin(float c) const { return std::clamp(int(invBinW > 0.f ? (cHi - c) * invBinW : (cHi - c) / binW), 0, bins - 1); }
@@ -569,6 +600,8 @@ void addBin(Layer& l, const Split::Histogram& h, int b) {
     l.invDepthMin = std::min(l.invDepthMin, h.invMin[b]);
     l.motionMax = vmax(l.motionMax, h.motionMax[b]);
     l.sagMax = vmax(l.sagMax, h.sagMax[b]);
+    l.arcSag += h.arcSag[b];
+    l.arcMotion += h.arcMotion[b];
 }
 
 /// What a tile's samples are split into layers by (splitLayers): their defocus slope, which falls
@@ -905,6 +938,8 @@ void splitLayers(Samples& g, const SlopeRange (&range)[kClasses], const float (&
         h.invMin.assign(h.bins, kInf);
         h.motionMax.assign(h.bins, Vec2f{});
         h.sagMax.assign(h.bins, Vec2f{});
+        h.arcSag.assign(h.bins, 0.0);
+        h.arcMotion.assign(h.bins, 0.0);
     }
     // Consecutive samples mostly fall in one bin (a pixel's, its neighbour's: one surface), so
     // each class sums its current run of one bin in registers and adds the run to the bin when
@@ -914,6 +949,7 @@ void splitLayers(Samples& g, const SlopeRange (&range)[kClasses], const float (&
         double c = 0, mx = 0, my = 0, m2 = 0, mx2 = 0, invDepth = 0;
         float cMin = kInf, cMax = -kInf, invMax = 0, invMin = kInf;
         Vec2f motionMax{}, sagMax{};
+        double arcSag = 0, arcMotion = 0;
     };
     Run run[kClasses];
     auto flush = [&](int cls) {
@@ -933,6 +969,8 @@ void splitLayers(Samples& g, const SlopeRange (&range)[kClasses], const float (&
         h.invMin[r.bin] = std::min(h.invMin[r.bin], r.invMin);
         h.motionMax[r.bin] = vmax(h.motionMax[r.bin], r.motionMax);
         h.sagMax[r.bin] = vmax(h.sagMax[r.bin], r.sagMax);
+        h.arcSag[r.bin] += r.arcSag;
+        h.arcMotion[r.bin] += r.arcMotion;
         r = Run{};
     };
     // (With still samples alone, as in a tile without motion, the class is 0 for every sample:
@@ -960,6 +998,15 @@ void splitLayers(Samples& g, const SlopeRange (&range)[kClasses], const float (&
             r.invMin = std::min(r.invMin, s.invDepth);
             r.motionMax = vmax(r.motionMax, Vec2f{std::abs(s.mx), std::abs(s.my)});
             r.sagMax = vmax(r.sagMax, Vec2f{std::abs(s.sx), std::abs(s.sy)});
+            if (curved(s)) {
+                // (Its sagitta across its chord: along it a sagitta is a turn in depth's uneven
+                // pace, whose ratio to the chord depends on where the point is on its circle.)
+                const double m = std::sqrt(double(s.mx) * s.mx + double(s.my) * s.my);
+                if (m > 1e-3) {
+                    r.arcSag += std::abs(double(s.sx) * s.my - double(s.sy) * s.mx) / m;
+                    r.arcMotion += m;
+                }
+            }
         }
     };
     bool stillOnly = true;
@@ -1015,6 +1062,7 @@ void splitLayers(Samples& g, const SlopeRange (&range)[kClasses], const float (&
         l.motionRmsX = float(std::sqrt(l.sumMx2 * inv));
         l.motionRmsY = float(std::sqrt(std::max(0.0, l.sumM2 - l.sumMx2) * inv));
         l.invDepth = float(l.sumInvDepth * inv);
+        l.arc.build(l.arcMotion > 0 ? float(4.0 * std::atan(2.0 * l.arcSag / l.arcMotion)) : 0.f);
     }
     // Front to back: by mean inverse depth (a miss is at 0), which orders layers of any slope; a
     // moving layer by its nearest sample's (below).
@@ -1607,6 +1655,22 @@ void traceBlurredRays(const Layer& l, const Rays& ray, int j0, int j1, const Ble
     float shearA[Layer::kShearSteps + 1], shearB[Layer::kShearSteps + 1];
     for (int i = 0; i <= Layer::kShearSteps; ++i) shearA[i] = l.shearTable[i].a, shearB[i] = l.shearTable[i].b;
     const AffineMotion fit = l.motionFit, sagFit = l.sagFit;
+    // (kCurved) Each ray's chord pace over motionScale and its sagitta's on its arc (ArcPace), at
+    // its shutter offset as its motion is scaled, by a loop of their own: computed in the rays'
+    // loop, GCC kept that loop scalar. (Where motionScale is 0 the chord's pace is scaled by it
+    // wherever it is used: 0 as well.)
+    alignas(64) float arcSt[Rays::kMax], arcK[Rays::kMax];
+    if constexpr (kCurved) {
+        const ArcPace pace = l.arc;
+        const float motionScale = l.motionScale, invMotionScale = motionScale > 0.f ? 1.f / motionScale : 0.f;
+        const float rayT2 = l.rayT2, depthRate = l.depthRate;
+#pragma omp simd
+        for (int j = j0; j < j1; ++j) {
+            const float dt = ray.dt[j], shaped = dt * (1.f + rayT2 * 4.f * dt * dt);
+            arcSt[j] = pace.chord(motionScale * alongChord(shaped, depthRate)) * invMotionScale;
+            arcK[j] = pace.arc(motionScale * shaped);
+        }
+    }
     float* takenAlpha = taken.alpha;
     float* takenR = taken.r;
     float* takenG = taken.g;
@@ -1615,16 +1679,15 @@ void traceBlurredRays(const Layer& l, const Rays& ray, int j0, int j1, const Ble
     for (int j = j0; j < j1; ++j) {
         const float dt = ray.dt[j];
         const float shaped = dt * (1.f + l.rayT2 * 4.f * dt * dt);
-        const float st = alongChord(shaped, l.depthRate);
-        // (kCurved: 4 tau^2, tau the ray's shutter offset as its motion is scaled: curvedShift.)
-        const float tau = l.motionScale * shaped, arcK = 4.f * tau * tau;
+        // (kCurved: on its arc, arcSt and arcK above.)
+        const float st = kCurved ? arcSt[j] : alongChord(shaped, l.depthRate);
         float mox = l.rayMx * st, moy = l.rayMy * st;
         float cRay = l.rayC + l.rayC2 * ray.u2[j];
         if constexpr (followMotion) {
             // (One expression: a Vec2f declared here and assigned in the branches became a
             // per-lane array with masked stores, and the moving variants' loops did not vectorise.)
             const float qx = ray.px[j] + cRay * ray.ux[j], qy = ray.py[j] - cRay * ray.uy[j];
-            const Vec2f shift = kCurved ? curvedMotionShift(fit, sagFit, qx, qy, l.motionScale * st, arcK, {mox, moy})
+            const Vec2f shift = kCurved ? curvedMotionShift(fit, sagFit, qx, qy, l.motionScale * st, arcK[j], {mox, moy})
                                         : motionShift(fit, qx, qy, l.motionScale * st, {mox, moy});
             mox = shift.x, moy = shift.y;
         }
@@ -1654,7 +1717,7 @@ void traceBlurredRays(const Layer& l, const Rays& ray, int j0, int j1, const Ble
                         // towards its mid-shutter place; then a second step, the motion and the
                         // sagitta where the first put it (the sagitta moves the lookup by up to
                         // its length).
-                        const float k = arcK;
+                        const float k = arcK[j];
                         const Vec2f e = vectorAt(sagGrid, b);
                         mox -= k * e.x;
                         moy -= k * e.y;
@@ -1728,11 +1791,13 @@ void motionCells(const Layer& l, const int* occupied, int margin, MotionBatch& b
     const int gw = l.gw, gh = l.gh, ow = gw + 1, n = b.n;
     const float inv = l.invStep;  // (pixels to cells)
     const AffineMotion fit = l.motionFit, sagFit = l.sagFit;
+    const ArcPace pace = l.arc;  // (a copy out of the loop, as the fits)
 #pragma omp simd
     for (int j = 0; j < n; ++j) {
-        const float qx = b.qx[j], qy = b.qy[j], dt = alongChord(b.t[j] - 0.5f, l.depthRate);
+        const float qx = b.qx[j], qy = b.qy[j], chordPace = alongChord(b.t[j] - 0.5f, l.depthRate);
+        const float dt = kCurved ? pace.chord(chordPace) : chordPace;
         const float r = std::abs(dt) * l.maxMotion + (kCurved ? l.maxSag : 0.f) + 1.f;
-        const float d = b.t[j] - 0.5f, k = 4.f * d * d;  // (kCurved)
+        const float d = b.t[j] - 0.5f, k = kCurved ? pace.arc(d) : 4.f * d * d;  // (kCurved)
         const int i0 = int(std::floor((qx - r) * inv)) - l.gx0 - margin, i1 = int(std::floor((qx + r) * inv)) - l.gx0 + margin;
         const int j0 = int(std::floor((qy - r) * inv)) - l.gy0 - margin, j1 = int(std::floor((qy + r) * inv)) - l.gy0 + margin;
         // The rectangle clamped to the grid (empty where it misses the grid).
@@ -2598,8 +2663,10 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                     const bool arc = l.motion && curved(s);
                     const Vec2f e = arc ? effectiveSag(s, l.depthRate) : Vec2f{0.f, 0.f};
                     if (arc) {
-                        const Vec2f shift = curvedShift(e, s.t);
-                        own = {own.x + shift.x, own.y + shift.y};
+                        // On its arc (ArcPace): A(a) of the chord back and B(t - 1/2) of the sagitta.
+                        const ArcPace& pace = layers[size_t(sl)].arc;
+                        const float a = alongChord(s.t - 0.5f, l.depthRate), along = pace.chord(a) - a, across = pace.arc(s.t - 0.5f);
+                        own = {own.x - along * s.mx + across * e.x, own.y - along * s.my + across * e.y};
                     }
                     const int ci = l.cellIndex(own);
                     if (ci < 0) continue;
