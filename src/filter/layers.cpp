@@ -259,9 +259,22 @@ struct ArcPace {
     float theta2 = 0, invSincHalf = 1, invBendHalf = 1;  // theta^2, 1 / sinc(theta/2), 1 / f(theta/2)
     static float sinc(float u) { return 1.f - u * (1.f / 6 - u * (1.f / 120 - u * (1.f / 5040 - u * (1.f / 362880)))); }  // u = x^2
     static float bend(float u) { return 1.f - u * (1.f / 12 - u * (1.f / 360 - u * (1.f / 20160 - u * (1.f / 1814400)))); }
-    /// For a turn of `theta` radians (0: the parabola's d and 4 d^2), at most half a turn.
-    void build(float theta) {
-        const float t = std::clamp(theta, 0.f, kPi);
+    /// For a turn of `theta` radians, at most half a turn, of samples moving at most `motion`
+    /// pixels along a chord and `sag` across it: the parabola's d and 4 d^2 (theta 0) where the
+    /// arc would move none of their points by a quarter of a pixel from it (the same images and
+    /// time as before where a layer turns little or in depth: ArcPace's rays run slower).
+    void build(float theta, float motion, float sag) {
+        float t = std::clamp(theta, 0.f, kPi);
+        if (t > 0.f) {
+            const double sinHalf = std::sin(0.5 * t), cosHalf = std::cos(0.5 * t);
+            double most = 0;
+            for (int i = 1; i <= 16; ++i) {
+                const double d = 0.5 * i / 16.0;
+                most = std::max(most, std::abs(std::sin(t * d) / (2.0 * sinHalf) - d) * motion +
+                                          std::abs((1.0 - std::cos(t * d)) / (1.0 - cosHalf) - 4.0 * d * d) * sag);
+            }
+            if (most < 0.25) t = 0.f;
+        }
         theta2 = t * t;
         invSincHalf = 1.f / sinc(0.25f * theta2);
         invBendHalf = 1.f / bend(0.25f * theta2);
@@ -1062,7 +1075,8 @@ void splitLayers(Samples& g, const SlopeRange (&range)[kClasses], const float (&
         l.motionRmsX = float(std::sqrt(l.sumMx2 * inv));
         l.motionRmsY = float(std::sqrt(std::max(0.0, l.sumM2 - l.sumMx2) * inv));
         l.invDepth = float(l.sumInvDepth * inv);
-        l.arc.build(l.arcMotion > 0 ? float(4.0 * std::atan(2.0 * l.arcSag / l.arcMotion)) : 0.f);
+        l.arc.build(l.arcMotion > 0 ? float(4.0 * std::atan(2.0 * l.arcSag / l.arcMotion)) : 0.f, std::sqrt(sqr(l.motionMax.x) + sqr(l.motionMax.y)),
+                    std::sqrt(sqr(l.sagMax.x) + sqr(l.sagMax.y)));
     }
     // Front to back: by mean inverse depth (a miss is at 0), which orders layers of any slope; a
     // moving layer by its nearest sample's (below).
@@ -1642,7 +1656,7 @@ bool compositeTaken(Rays& ray, int index, const Taken& taken, int j0, int j1) {
 /// sampling's time; docs/layers.md, "Rays traced once per layer where the order changes".)
 /// (kGrid: the layer has a motion grid, followed as above; a template parameter, since a
 /// runtime condition in the loop left its lookups masked, and GCC kept such loops scalar.)
-template <bool kFollow, bool kMoving, bool kGrid, bool kCurved>
+template <bool kFollow, bool kMoving, bool kGrid, bool kCurved, bool kArc = false>
 void traceBlurredRays(const Layer& l, const Rays& ray, int j0, int j1, const Blend& own, Taken& taken) {
     const int cs = l.cellStride(), bins = l.timeBins;
     const float ownW = own.w, ownA = own.alpha, ownR = own.r, ownG = own.g, ownB = own.b;
@@ -1655,12 +1669,13 @@ void traceBlurredRays(const Layer& l, const Rays& ray, int j0, int j1, const Ble
     float shearA[Layer::kShearSteps + 1], shearB[Layer::kShearSteps + 1];
     for (int i = 0; i <= Layer::kShearSteps; ++i) shearA[i] = l.shearTable[i].a, shearB[i] = l.shearTable[i].b;
     const AffineMotion fit = l.motionFit, sagFit = l.sagFit;
-    // (kCurved) Each ray's chord pace over motionScale and its sagitta's on its arc (ArcPace), at
-    // its shutter offset as its motion is scaled, by a loop of their own: computed in the rays'
-    // loop, GCC kept that loop scalar. (Where motionScale is 0 the chord's pace is scaled by it
-    // wherever it is used: 0 as well.)
-    alignas(64) float arcSt[Rays::kMax], arcK[Rays::kMax];
-    if constexpr (kCurved) {
+    // (kArc: a turning layer's arcs where they are not its parabolas, ArcPace.) Each ray's chord
+    // pace over motionScale, at its shutter offset as its motion is scaled, by a loop of its own
+    // (computed in the rays' loop, GCC kept that loop scalar; even so it runs its scalar version
+    // there, seen with perf: a lead), and its sagitta's pace in the loop. (Where motionScale is 0
+    // the chord's pace is scaled by it wherever it is used: 0 as well.)
+    alignas(64) float arcSt[Rays::kMax];
+    if constexpr (kArc) {
         const ArcPace pace = l.arc;
         const float motionScale = l.motionScale, invMotionScale = motionScale > 0.f ? 1.f / motionScale : 0.f;
         const float rayT2 = l.rayT2, depthRate = l.depthRate;
@@ -1668,7 +1683,6 @@ void traceBlurredRays(const Layer& l, const Rays& ray, int j0, int j1, const Ble
         for (int j = j0; j < j1; ++j) {
             const float dt = ray.dt[j], shaped = dt * (1.f + rayT2 * 4.f * dt * dt);
             arcSt[j] = pace.chord(motionScale * alongChord(shaped, depthRate)) * invMotionScale;
-            arcK[j] = pace.arc(motionScale * shaped);
         }
     }
     float* takenAlpha = taken.alpha;
@@ -1679,15 +1693,18 @@ void traceBlurredRays(const Layer& l, const Rays& ray, int j0, int j1, const Ble
     for (int j = j0; j < j1; ++j) {
         const float dt = ray.dt[j];
         const float shaped = dt * (1.f + l.rayT2 * 4.f * dt * dt);
-        // (kCurved: on its arc, arcSt and arcK above.)
-        const float st = kCurved ? arcSt[j] : alongChord(shaped, l.depthRate);
+        // (kCurved: 4 tau^2, tau the ray's shutter offset as its motion is scaled: curvedShift;
+        // kArc: on its arc, ArcPace.)
+        const float st = kArc ? arcSt[j] : alongChord(shaped, l.depthRate);
+        const float tau = l.motionScale * shaped;
+        const float arcKj = kArc ? 4.f * tau * tau * ArcPace::bend(l.arc.theta2 * tau * tau) * l.arc.invBendHalf : 4.f * tau * tau;
         float mox = l.rayMx * st, moy = l.rayMy * st;
         float cRay = l.rayC + l.rayC2 * ray.u2[j];
         if constexpr (followMotion) {
             // (One expression: a Vec2f declared here and assigned in the branches became a
             // per-lane array with masked stores, and the moving variants' loops did not vectorise.)
             const float qx = ray.px[j] + cRay * ray.ux[j], qy = ray.py[j] - cRay * ray.uy[j];
-            const Vec2f shift = kCurved ? curvedMotionShift(fit, sagFit, qx, qy, l.motionScale * st, arcK[j], {mox, moy})
+            const Vec2f shift = kCurved ? curvedMotionShift(fit, sagFit, qx, qy, l.motionScale * st, arcKj, {mox, moy})
                                         : motionShift(fit, qx, qy, l.motionScale * st, {mox, moy});
             mox = shift.x, moy = shift.y;
         }
@@ -1717,7 +1734,7 @@ void traceBlurredRays(const Layer& l, const Rays& ray, int j0, int j1, const Ble
                         // towards its mid-shutter place; then a second step, the motion and the
                         // sagitta where the first put it (the sagitta moves the lookup by up to
                         // its length).
-                        const float k = arcK[j];
+                        const float k = arcKj;
                         const Vec2f e = vectorAt(sagGrid, b);
                         mox -= k * e.x;
                         moy -= k * e.y;
@@ -1764,7 +1781,11 @@ void traceBlurredRays(const Layer& l, const Rays& ray, int j0, int j1, const Ble
 template <bool kFollow, bool kMoving, bool kCurved = false>
 void traceBlurred(const Layer& l, const Rays& ray, int j0, int j1, const Blend& own, Taken& taken) {
     if constexpr (kMoving) {
-        if (!l.motionGrid.empty()) return traceBlurredRays<kFollow, true, true, kCurved>(l, ray, j0, j1, own, taken);
+        if (!l.motionGrid.empty()) {
+            if constexpr (kCurved)
+                if (l.arc.theta2 > 0.f) return traceBlurredRays<kFollow, true, true, true, true>(l, ray, j0, j1, own, taken);
+            return traceBlurredRays<kFollow, true, true, kCurved>(l, ray, j0, j1, own, taken);
+        }
     }
     traceBlurredRays<kFollow, kMoving, false, false>(l, ray, j0, j1, own, taken);
 }
