@@ -1669,22 +1669,12 @@ void traceBlurredRays(const Layer& l, const Rays& ray, int j0, int j1, const Ble
     float shearA[Layer::kShearSteps + 1], shearB[Layer::kShearSteps + 1];
     for (int i = 0; i <= Layer::kShearSteps; ++i) shearA[i] = l.shearTable[i].a, shearB[i] = l.shearTable[i].b;
     const AffineMotion fit = l.motionFit, sagFit = l.sagFit;
-    // (kArc: a turning layer's arcs where they are not its parabolas, ArcPace.) Each ray's chord
-    // pace over motionScale, at its shutter offset as its motion is scaled, by a loop of its own
-    // (computed in the rays' loop, GCC kept that loop scalar; even so it runs its scalar version
-    // there, seen with perf: a lead), and its sagitta's pace in the loop. (Where motionScale is 0
-    // the chord's pace is scaled by it wherever it is used: 0 as well.)
-    alignas(64) float arcSt[Rays::kMax];
-    if constexpr (kArc) {
-        const ArcPace pace = l.arc;
-        const float motionScale = l.motionScale, invMotionScale = motionScale > 0.f ? 1.f / motionScale : 0.f;
-        const float rayT2 = l.rayT2, depthRate = l.depthRate;
-#pragma omp simd
-        for (int j = j0; j < j1; ++j) {
-            const float dt = ray.dt[j], shaped = dt * (1.f + rayT2 * 4.f * dt * dt);
-            arcSt[j] = pace.chord(motionScale * alongChord(shaped, depthRate)) * invMotionScale;
-        }
-    }
+    // (kArc: a turning layer's arcs where they are not its parabolas, ArcPace. That loop is not
+    // vectorised: with the arcs' pace GCC's if-conversion gives up on it, "control flow in loop",
+    // whether the pace is computed in it, read from a table or from a loop of its own; a lead.
+    // Where motionScale is 0 the chord's pace is scaled by it wherever it is used: 0 as well.)
+    const ArcPace arc = l.arc;
+    const float invMotionScale = l.motionScale > 0.f ? 1.f / l.motionScale : 0.f;
     float* takenAlpha = taken.alpha;
     float* takenR = taken.r;
     float* takenG = taken.g;
@@ -1695,9 +1685,9 @@ void traceBlurredRays(const Layer& l, const Rays& ray, int j0, int j1, const Ble
         const float shaped = dt * (1.f + l.rayT2 * 4.f * dt * dt);
         // (kCurved: 4 tau^2, tau the ray's shutter offset as its motion is scaled: curvedShift;
         // kArc: on its arc, ArcPace.)
-        const float st = kArc ? arcSt[j] : alongChord(shaped, l.depthRate);
-        const float tau = l.motionScale * shaped;
-        const float arcKj = kArc ? 4.f * tau * tau * ArcPace::bend(l.arc.theta2 * tau * tau) * l.arc.invBendHalf : 4.f * tau * tau;
+        const float chordPace = alongChord(shaped, l.depthRate), tau = l.motionScale * shaped;
+        const float st = kArc ? arc.chord(l.motionScale * chordPace) * invMotionScale : chordPace;
+        const float arcKj = kArc ? arc.arc(tau) : 4.f * tau * tau;
         float mox = l.rayMx * st, moy = l.rayMy * st;
         float cRay = l.rayC + l.rayC2 * ray.u2[j];
         if constexpr (followMotion) {
