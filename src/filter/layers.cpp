@@ -253,7 +253,7 @@ inline Vec2f curvedShift(Vec2f e, float t) {
 /// theta is its samples' (|e| / |m| = tan(theta/4) / 2, e across the chord), at most half a
 /// turn, and A and B are d sinc(theta d) / sinc(theta/2) and 4 d^2 f(theta d) / f(theta/2), f(x) =
 /// 2 (1 - cos x) / x^2, each a polynomial in (theta d)^2 to within 3e-6 (plain arithmetic, for
-/// the SIMD loops). (With the parabola the bars of docs/fan.json turning 90 degrees showed sectors
+/// motionCells' SIMD loop; the rays' loop with it is not vectorised: traceBlurredRays, kArc). (With the parabola the bars of docs/fan.json turning 90 degrees showed sectors
 /// 10% too bright or too dark winding with the turn: docs/layers.md, "Arcs of a large turn".)
 struct ArcPace {
     float theta2 = 0, invSincHalf = 1, invBendHalf = 1;  // theta^2, 1 / sinc(theta/2), 1 / f(theta/2)
@@ -416,8 +416,8 @@ struct Layer {
     // the largest measured 10-28% more stage time on docs/sponza-dolly.json and turning-room.json
     // for the same or 3% higher relMSE (there a clamped edge continues a large surface).
     Vec2f motionMax{}, sagMax{};
-    // Its turning samples' summed |sagitta| and |motion| (the turn's angle: ArcPace) and the
-    // tables of their pace along their arcs.
+    // Its turning samples' summed |sagitta| across their chords and |motion| (the turn's angle),
+    // and their pace along their arcs (ArcPace).
     double arcSag = 0, arcMotion = 0;
     ArcPace arc;
     // The rays' shear, shaped by the grid's own blur (Shaped): a ray at lens point u (unit disc)
