@@ -229,21 +229,6 @@ inline Vec2f shearOf(const Gathered& s, float c, float mx, float my, float g) {
 inline Vec2f layerPosition(const Gathered& s, bool sharp, float c, float mx, float my, float g) {
     return sharp ? Vec2f{s.x, s.y} : shearOf(s, c, mx, my, g);
 }
-/// Curved trajectories. A turning object's point moves on the screen along an arc, not its
-/// chord: at mid-shutter it is off the chord's middle by its sagitta s (TracedSample::sag;
-/// along the chord as well as across it: a point turning in depth near a silhouette moves
-/// unevenly along it). Its sample is reprojected along the parabola through the chord's ends and
-/// that point, y(t) = chord(t) - 4 e (t - 1/2)^2, chord(t) the chord at alongChord's pace,
-/// whose mid-shutter point is already m g / 4 along the chord (alongChord), so e = s - m g / 4.
-/// Along the chord alone a sample taken at the open or the close of the shutter landed up to
-/// |s| from its point's mid-shutter place, and a turning bunny's silhouette, whose points move
-/// in depth there, came out sharp and 2 px wide of its blurred edge (docs/layers.md, "Curved
-/// trajectories"). Where a sample taken at time t with effective sagitta e lies in its own
-/// layer's sharp image: its shear plus this.
-inline Vec2f curvedShift(Vec2f e, float t) {
-    const float d = t - 0.5f, k = 4.f * d * d;
-    return {k * e.x, k * e.y};
-}
 /// Arcs of a large turn. The parabola of curvedShift is the arc's limit for a small turn; a
 /// point turning at a steady rate by theta over the shutter is, at shutter offset d (its chord's
 /// pace a), A(a) m - B(d) e from its mid-shutter place, A(a) = sin(theta a) / (2 sin(theta/2)),
@@ -253,8 +238,9 @@ inline Vec2f curvedShift(Vec2f e, float t) {
 /// theta is its samples' (|e| / |m| = tan(theta/4) / 2, e across the chord), at most half a
 /// turn, and A and B are d sinc(theta d) / sinc(theta/2) and 4 d^2 f(theta d) / f(theta/2), f(x) =
 /// 2 (1 - cos x) / x^2, each a polynomial in (theta d)^2 to within 3e-6 (plain arithmetic, for
-/// motionCells' SIMD loop; the rays' loop with it is not vectorised: traceBlurredRays, kArc). (With the parabola the bars of docs/fan.json turning 90 degrees showed sectors
-/// 10% too bright or too dark winding with the turn: docs/layers.md, "Arcs of a large turn".)
+/// motionCells' SIMD loop; the rays' loop with it is not vectorised: traceBlurredRays, kArc).
+/// (With the parabola the bars of docs/fan.json turning 90 degrees showed sectors 10% too bright
+/// or too dark winding with the turn: docs/layers.md, "Arcs of a large turn".)
 struct ArcPace {
     float theta2 = 0, invSincHalf = 1, invBendHalf = 1;  // theta^2, 1 / sinc(theta/2), 1 / f(theta/2)
     static float sinc(float u) { return 1.f - u * (1.f / 6 - u * (1.f / 120 - u * (1.f / 5040 - u * (1.f / 362880)))); }  // u = x^2
@@ -283,6 +269,23 @@ struct ArcPace {
     [[gnu::always_inline]] float chord(float a) const { return a * sinc(theta2 * a * a) * invSincHalf; }
     [[gnu::always_inline]] float arc(float d) const { return 4.f * d * d * bend(theta2 * d * d) * invBendHalf; }
 };
+/// Curved trajectories. A turning object's point moves on the screen along an arc, not its
+/// chord: at mid-shutter it is off the chord's middle by its sagitta s (TracedSample::sag;
+/// along the chord as well as across it: a point turning in depth near a silhouette moves
+/// unevenly along it). Its sample is reprojected along the parabola through the chord's ends and
+/// that point, y(t) = chord(t) - 4 e (t - 1/2)^2, chord(t) the chord at alongChord's pace,
+/// whose mid-shutter point is already m g / 4 along the chord (alongChord), so e = s - m g / 4.
+/// Along the chord alone a sample taken at the open or the close of the shutter landed up to
+/// |s| from its point's mid-shutter place, and a turning bunny's silhouette, whose points move
+/// in depth there, came out sharp and 2 px wide of its blurred edge (docs/layers.md, "Curved
+/// trajectories"). Where a sample taken at time t, at its chord's pace a (alongChord), with
+/// motion m and effective sagitta e lies in its own layer's sharp image: its shear plus this,
+/// 4 e (t - 1/2)^2 on the parabola, and along a large turn's arc its pace's difference from the
+/// chord's too (ArcPace: with theta 0, the parabola exactly).
+inline Vec2f curvedShift(const ArcPace& pace, Vec2f m, Vec2f e, float a, float t) {
+    const float along = pace.chord(a) - a, across = pace.arc(t - 0.5f);
+    return {across * e.x - along * m.x, across * e.y - along * m.y};
+}
 /// The effective sagitta e of a sample in a layer of depth rate g (curvedShift).
 inline Vec2f effectiveSag(const Gathered& s, float g) { return {s.sx - 0.25f * g * s.mx, s.sy - 0.25f * g * s.my}; }
 inline bool curved(const Gathered& s) { return s.sx != 0.f || s.sy != 0.f; }
@@ -2674,10 +2677,8 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                     const bool arc = l.motion && curved(s);
                     const Vec2f e = arc ? effectiveSag(s, l.depthRate) : Vec2f{0.f, 0.f};
                     if (arc) {
-                        // On its arc (ArcPace): A(a) of the chord back and B(t - 1/2) of the sagitta.
-                        const ArcPace& pace = layers[size_t(sl)].arc;
-                        const float a = alongChord(s.t - 0.5f, l.depthRate), along = pace.chord(a) - a, across = pace.arc(s.t - 0.5f);
-                        own = {own.x - along * s.mx + across * e.x, own.y - along * s.my + across * e.y};
+                        const Vec2f shift = curvedShift(layers[size_t(sl)].arc, {s.mx, s.my}, e, alongChord(s.t - 0.5f, l.depthRate), s.t);
+                        own = {own.x + shift.x, own.y + shift.y};
                     }
                     const int ci = l.cellIndex(own);
                     if (ci < 0) continue;
