@@ -218,6 +218,9 @@ inline bool inFrontOfMoving(float invDepthMax, float g, float q, float t) {
 /// The largest offset of a point from its mid-shutter position, as a share of its chord, where
 /// its depth changes at the rate g (alongChord): (1 + |g| / 2) / 2.
 inline float chordReach(float g) { return 0.5f * (1.f + 0.5f * std::abs(g)); }
+/// The middle of the chord, as an offset from the mid-shutter point (a share of the chord) where
+/// the depth changes at the rate g: (alongChord(1/2, g) + alongChord(-1/2, g)) / 2 = -g / 4.
+[[gnu::always_inline]] inline float chordMiddle(float g) { return -0.25f * g; }
 /// Where sample s lies in the sharp image of slope c and screen motion (mx, my) of a surface
 /// whose depth changes at the relative rate g (alongChord): y = x + c u - m a(t) (film y: y - c
 /// v - m_y a(t)), a(t) = alongChord(t - 1/2, g), t - 1/2 where g = 0.
@@ -419,6 +422,12 @@ struct Layer {
     // the largest measured 10-28% more stage time on docs/sponza-dolly.json and turning-room.json
     // for the same or 3% higher relMSE (there a clamped edge continues a large surface).
     Vec2f motionMax{}, sagMax{};
+    // A moving layer's: how far from the tile (per axis, pixels) the sharp positions of those of
+    // its samples lie whose paths over the shutter (the lens's disc around them) cross the tile,
+    // the farthest of them (tileReach in reconstructLayers). Where its motion varies across it (an
+    // object moving in depth grows or shrinks on screen) the points that reach the tile late or
+    // early lie farther than the root mean square of the motion says.
+    Vec2f tileNeed{};
     // Its turning samples' summed |sagitta| across their chords and |motion| (the turn's angle),
     // and their pace along their arcs (ArcPace).
     double arcSag = 0, arcMotion = 0;
@@ -1468,8 +1477,10 @@ AffineMotion inPixels(const AffineMotion& f, const Layer& l) {
 /// crosses late and early in the shutter past it, and counted the sky's samples beside the rim
 /// in the sphere's D: the middle of docs/motion.json's trail at 1024x1024 (282 px) was 4.5% too
 /// dark with layers, for every method (docs/layers.md, "The rim's motion beyond the rim").
+/// `residuals`: the sums are of the differences from the (unclamped) fit at the cells' centres,
+/// and a cell's mean is the fit there plus their mean (the motion grid).
 void meanVectorGrid(const float* count, int cs, const float* sums, int ss, int gw, int gh, const AffineMotion& fit,
-                    std::vector<float>& grid) {
+                    std::vector<float>& grid, bool residuals) {
     const size_t cells = size_t(gw) * gh;
     grid.resize(cells * 2);
     auto has = [&](size_t i) { return !(count[i * cs] < 0.05f); };
@@ -1479,6 +1490,10 @@ void meanVectorGrid(const float* count, int cs, const float* sums, int ss, int g
         if (!has(i)) continue;
         const float n = count[i * cs];
         grid[2 * i] = sums[i * ss] / n, grid[2 * i + 1] = sums[i * ss + 1] / n;
+        if (residuals) {
+            const Vec2f f = fit.at({float(i % size_t(gw)) + 0.5f, float(i / size_t(gw)) + 0.5f}, kInf);
+            grid[2 * i] += f.x, grid[2 * i + 1] += f.y;
+        }
         deviation = std::max(deviation, sqr(grid[2 * i] - fit.mean.x) + sqr(grid[2 * i + 1] - fit.mean.y));
         any = true;
     }
@@ -1678,6 +1693,11 @@ void traceBlurredRays(const Layer& l, const Rays& ray, int j0, int j1, const Ble
     // Where motionScale is 0 the chord's pace is scaled by it wherever it is used: 0 as well.)
     const ArcPace arc = l.arc;
     const float invMotionScale = l.motionScale > 0.f ? 1.f / l.motionScale : 0.f;
+    // The chord's middle, as an offset from the mid-shutter point (chords; chordMiddle), and the
+    // layer's mean motion times it: the rays' segment is shaped about it (below). -0 where the
+    // depth rate is 0.
+    const float middle = chordMiddle(l.depthRate), middleX = l.mx * middle, middleY = l.my * middle;
+    const float depthRate = l.depthRate, rayT2 = l.rayT2;
     float* takenAlpha = taken.alpha;
     float* takenR = taken.r;
     float* takenG = taken.g;
@@ -1685,20 +1705,31 @@ void traceBlurredRays(const Layer& l, const Rays& ray, int j0, int j1, const Ble
 #pragma omp simd
     for (int j = j0; j < j1; ++j) {
         const float dt = ray.dt[j];
-        const float shaped = dt * (1.f + l.rayT2 * 4.f * dt * dt);
+        // Where along its chord the point the ray finds is at its time (alongChord), from the
+        // chord's middle, and that offset shaped for the grid's blur (shapeRays), about the
+        // chord's middle, so that both ends of the segment are drawn in as far. (Before, the time
+        // was shaped, about the mid-shutter point: where the depth changes fast that point lies
+        // near one end of the chord, and the other end was drawn in the farthest. The same where
+        // the depth rate is 0. docs/layers.md, "An object rushing towards the camera".)
+        const float along = alongChord(dt, depthRate) - middle;
+        const float shaped = along * (1.f + rayT2 * 4.f * along * along);
+        // st: that offset over the chord, as the layer's rays scale it (rayMx = motionScale mx),
+        // from the chord's middle; sPos = motionScale st + middle, from the mid-shutter point.
         // (kCurved: 4 tau^2, tau the ray's shutter offset as its motion is scaled: curvedShift;
-        // kArc: on its arc, ArcPace.)
-        const float chordPace = alongChord(shaped, l.depthRate), tau = l.motionScale * shaped;
-        const float st = kArc ? arc.chord(l.motionScale * chordPace) * invMotionScale : chordPace;
+        // kArc: on its arc, ArcPace. Written with the middle added last, outside the product:
+        // added to st, GCC left the loop scalar where the layer has a motion grid.)
+        const float tau = l.motionScale * shaped;
+        const float st = kArc ? arc.chord(tau) * invMotionScale : shaped;
+        const float sPos = (kArc ? arc.chord(tau) : tau) + middle;
         const float arcKj = kArc ? arc.arc(tau) : 4.f * tau * tau;
-        float mox = l.rayMx * st, moy = l.rayMy * st;
+        float mox = l.rayMx * st + middleX, moy = l.rayMy * st + middleY;
         float cRay = l.rayC + l.rayC2 * ray.u2[j];
         if constexpr (followMotion) {
             // (One expression: a Vec2f declared here and assigned in the branches became a
             // per-lane array with masked stores, and the moving variants' loops did not vectorise.)
             const float qx = ray.px[j] + cRay * ray.ux[j], qy = ray.py[j] - cRay * ray.uy[j];
-            const Vec2f shift = kCurved ? curvedMotionShift(fit, sagFit, qx, qy, l.motionScale * st, arcKj, {mox, moy})
-                                        : motionShift(fit, qx, qy, l.motionScale * st, {mox, moy});
+            const Vec2f shift = kCurved ? curvedMotionShift(fit, sagFit, qx, qy, sPos, arcKj, {mox, moy})
+                                        : motionShift(fit, qx, qy, sPos, {mox, moy});
             mox = shift.x, moy = shift.y;
         }
         if constexpr (kFollow || followMotion) {
@@ -1720,8 +1751,8 @@ void traceBlurredRays(const Layer& l, const Rays& ray, int j0, int j1, const Ble
             if constexpr (kMoving) {
                 if constexpr (followMotion) {
                     const Vec2f m = vectorAt(motionGrid, b);
-                    mox = l.motionScale * m.x * st;
-                    moy = l.motionScale * m.y * st;
+                    mox = l.motionScale * m.x * st + m.x * middle;
+                    moy = l.motionScale * m.y * st + m.y * middle;
                     if constexpr (kCurved) {
                         // On its arc (curvedShift): the point it finds there is 4 e tau^2 back
                         // towards its mid-shutter place; then a second step, the motion and the
@@ -1733,8 +1764,8 @@ void traceBlurredRays(const Layer& l, const Rays& ray, int j0, int j1, const Ble
                         moy -= k * e.y;
                         const Bilinear b2 = bilinear(l, {ray.px[j] + cRay * ray.ux[j] - mox, ray.py[j] - cRay * ray.uy[j] - moy});
                         const Vec2f m2 = vectorAt(motionGrid, b2), e2 = vectorAt(sagGrid, b2);
-                        mox = l.motionScale * m2.x * st - k * e2.x;
-                        moy = l.motionScale * m2.y * st - k * e2.y;
+                        mox = l.motionScale * m2.x * st + m2.x * middle - k * e2.x;
+                        moy = l.motionScale * m2.y * st + m2.y * middle - k * e2.y;
                     }
                 }
             }
@@ -2219,6 +2250,32 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                 splitLayers(g, keyRange, rate, depthRate, splitRange, o, split, key);
                 std::vector<Layer>& layers = split.layers;
                 layerTotal += layers.size();
+                if (groups > 0) {
+                    // Each moving layer's tileNeed: per sample of it, its path's ends (alongChord)
+                    // and the lens's disc around them against the tile's box. Only where the
+                    // sample's motion group changes in depth (Layer::depthRate), whose image grows
+                    // or shrinks over the shutter: where it moves at one depth its motion varies
+                    // little across it, and the root mean square reaches as far. Not the samples
+                    // of a pixel with bent paths (LightFieldSamples::bentReach: a surface turning
+                    // in depth past the arcs' limit), which lie off their chords: with them, the
+                    // box of docs/turning-room.json turning 120 degrees about its diagonal took
+                    // grids reaching farther, whose far cells held less of it than the clamped
+                    // edge did (MC relMSE +2%, seeds 3 and 4).
+                    const float bx0 = float(X0), by0 = float(Y0), bx1 = float(X1), by1 = float(Y1);
+                    for (const Gathered& a : g) {
+                        if (a.cls == 0 || depthRate[a.cls] == 0.f || lf.bentReach(a.pixel) > 0.f) continue;
+                        Layer& l = layers[size_t(split.layerOf(a))];
+                        if (!l.moving) continue;
+                        const Vec2f q = shearOf(a, l.c, a.mx, a.my, l.depthRate);
+                        const float a0 = alongChord(-0.5f, l.depthRate), a1 = alongChord(0.5f, l.depthRate), lens = std::abs(l.c);
+                        const float ex0 = q.x + a.mx * a0, ex1 = q.x + a.mx * a1, ey0 = q.y + a.my * a0, ey1 = q.y + a.my * a1;
+                        if (std::max(ex0, ex1) + lens < bx0 || std::min(ex0, ex1) - lens > bx1 || std::max(ey0, ey1) + lens < by0 ||
+                            std::min(ey0, ey1) - lens > by1)
+                            continue;
+                        // (Beyond the lens's reach, which reachAxes adds.)
+                        l.tileNeed = vmax(l.tileNeed, Vec2f{std::max({0.f, bx0 - lens - q.x, q.x - bx1 - lens}), std::max({0.f, by0 - lens - q.y, q.y - by1 - lens})});
+                    }
+                }
                 // Front to back at each time: where a moving layer passes in depth behind or in
                 // front of another layer over the shutter, the two are ordered in each of
                 // kOrderBins bins of shutter time (the rule per pair below); every other pair
@@ -2434,8 +2491,8 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                     const float k = chordReach(l.depthRate), s3 = 3.f * sigmaIn(l, step);
                     // (A turning layer's as far as its farthest-moving samples: Layer::motionMax.)
                     const bool turning = l.sagMax.x > 0.f || l.sagMax.y > 0.f;
-                    const float rx = turning ? k * l.motionMax.x + l.sagMax.x : k * l.motionRmsX;
-                    const float ry = turning ? k * l.motionMax.y + l.sagMax.y : k * l.motionRmsY;
+                    const float rx = turning ? k * l.motionMax.x + l.sagMax.x : std::max(k * l.motionRmsX, l.tileNeed.x);
+                    const float ry = turning ? k * l.motionMax.y + l.sagMax.y : std::max(k * l.motionRmsY, l.tileNeed.y);
                     return Vec2f{(std::abs(l.c) + rx) / float(step) + s3, (std::abs(l.c) + ry) / float(step) + s3};
                 };
                 // A grid's margin beyond its tile (cells) for a reach of r cells.
@@ -2795,9 +2852,27 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                         // The mean motion per cell, and where the layer turns the mean effective
                         // sagitta, the sums smoothed alike and over the same (smoothed) count.
                         const CellBox counted = o.everyCell ? CellBox{0, 0, l.gw, l.gh} : nonZeroBox(motionAcc[k], l.gw, l.gh, 3);  // (its N's cells)
+                        // The motion is smoothed as its differences from the affine fit (the
+                        // sums less the count times the fit at the cell), which meanVectorGrid adds
+                        // back: a Gaussian mean of the motion itself is pulled towards the inside
+                        // at a layer's rim, where the neighbours are all on one side, and an
+                        // object moving in depth, whose motion grows from its middle to its rim,
+                        // had its rim's motion short by sigma times that growth: the rays of the
+                        // pixels its rim reaches late missed it (an approaching plate's rim 15%
+                        // dark; docs/layers.md, "An object rushing towards the camera"). The fit
+                        // is an affine field's own mean, at the rim too.
+                        float* sumsM = motionAcc[k].data();
+                        for (int j = 0; j < l.gh; ++j)
+                            for (int i = 0; i < l.gw; ++i) {
+                                const size_t c = size_t(j) * l.gw + size_t(i);
+                                const float n = sumsM[c * 3];
+                                if (!(n > 0.f)) continue;
+                                const Vec2f at = fit.at({float(i) + 0.5f, float(j) + 0.5f}, kInf);
+                                sumsM[c * 3 + 1] -= n * at.x, sumsM[c * 3 + 2] -= n * at.y;
+                            }
                         smooth(motionAcc[k], l.gw, l.gh, 3, l.sigmaX(l.sigma), l.sigmaY(l.sigma), counted);
                         const float* count = motionAcc[k].data();  // (smoothed)
-                        meanVectorGrid(count, 3, count + 1, 3, l.gw, l.gh, fit, l.motionGrid);
+                        meanVectorGrid(count, 3, count + 1, 3, l.gw, l.gh, fit, l.motionGrid, true);
                         float reach = 0, spread = 0;
                         l.motionExtent = {};
                         for (size_t i = 0; i < l.motionGrid.size(); i += 2) {
@@ -2813,7 +2888,7 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                         l.sagExtent = {};
                         if (turning) {
                             smooth(sagAcc[k], l.gw, l.gh, 2, l.sigmaX(l.sigma), l.sigmaY(l.sigma), counted);
-                            meanVectorGrid(count, 3, sagAcc[k].data(), 2, l.gw, l.gh, sagFit, l.sagGrid);
+                            meanVectorGrid(count, 3, sagAcc[k].data(), 2, l.gw, l.gh, sagFit, l.sagGrid, false);
                             float most = 0;
                             for (size_t i = 0; i < l.sagGrid.size(); i += 2) {
                                 most = std::max(most, sqr(l.sagGrid[i]) + sqr(l.sagGrid[i + 1]));
@@ -2978,9 +3053,17 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                     l.buildCovered();
                     const float slopeReach = std::max({std::abs(l.cMin), std::abs(l.cMax), std::abs(l.rayC), std::abs(l.rayC + l.rayC2)});
                     const float chord = chordReach(l.depthRate);
-                    l.rayReach = slopeReach + chord * std::max(std::sqrt(l.rayMx * l.rayMx + l.rayMy * l.rayMy), l.motionScale * l.maxMotion) + l.maxSag;
-                    l.rayExtent = {slopeReach + chord * std::max(std::abs(l.rayMx), l.motionScale * l.motionExtent.x) + l.sagExtent.x,
-                                   slopeReach + chord * std::max(std::abs(l.rayMy), l.motionScale * l.motionExtent.y) + l.sagExtent.y};
+                    // (The rays' segment is shaped about the chord's middle, which lies off the
+                    // mid-shutter point where the depth changes: where motionScale < 1 its ends
+                    // reach that much farther than chord times motionScale, as a share of the motion.)
+                    const float beyond = std::max(0.f, std::abs(chordMiddle(l.depthRate)) * (1.f - l.motionScale));
+                    const Vec2f mean{std::abs(l.mx), std::abs(l.my)};
+                    l.rayReach = slopeReach + chord * std::max(std::sqrt(l.rayMx * l.rayMx + l.rayMy * l.rayMy), l.motionScale * l.maxMotion) +
+                                 beyond * std::max(std::sqrt(l.mx * l.mx + l.my * l.my), l.maxMotion) + l.maxSag;
+                    l.rayExtent = {slopeReach + chord * std::max(std::abs(l.rayMx), l.motionScale * l.motionExtent.x) +
+                                       beyond * std::max(mean.x, l.motionExtent.x) + l.sagExtent.x,
+                                   slopeReach + chord * std::max(std::abs(l.rayMy), l.motionScale * l.motionExtent.y) +
+                                       beyond * std::max(mean.y, l.motionExtent.y) + l.sagExtent.y};
                 }
                 // A layer a pixel's rays can see; a sharp still layer is the same for every ray
                 // (its pixel's cell), looked up once.
