@@ -422,11 +422,13 @@ struct Layer {
     // the largest measured 10-28% more stage time on docs/sponza-dolly.json and turning-room.json
     // for the same or 3% higher relMSE (there a clamped edge continues a large surface).
     Vec2f motionMax{}, sagMax{};
-    // A moving layer's: how far from the tile (per axis, pixels) the sharp positions of those of
-    // its samples lie whose paths over the shutter (the lens's disc around them) cross the tile,
-    // the farthest of them (tileReach in reconstructLayers). Where its motion varies across it (an
-    // object moving in depth grows or shrinks on screen) the points that reach the tile late or
-    // early lie farther than the root mean square of the motion says.
+    // A moving layer's whose depth changes: how far beyond the lens's reach from the tile (per
+    // axis, pixels) the sharp positions of those of its samples lie whose paths over the shutter
+    // (the lens's disc around them) cross the tile, the farthest of them (reachAxes in
+    // reconstructLayers). An object moving in depth grows or shrinks on screen, its motion
+    // growing from its middle to its rim, and the points that reach the tile late or early lie
+    // farther than the root mean square of the motion says (docs/layers.md, "An object rushing
+    // towards the camera").
     Vec2f tileNeed{};
     // Its turning samples' summed |sagitta| across their chords and |motion| (the turn's angle),
     // and their pace along their arcs (ArcPace).
