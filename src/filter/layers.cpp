@@ -2264,12 +2264,15 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                     // grids reaching farther, whose far cells held less of it than the clamped
                     // edge did (MC relMSE +2%, seeds 3 and 4).
                     const float bx0 = float(X0), by0 = float(Y0), bx1 = float(X1), by1 = float(Y1);
+                    // (Per motion group, where its chords end: every layer of the group has its
+                    // depth rate, splitLayers.)
+                    Vec2f chordEnds[kClasses];
+                    for (int k = 1; k <= groups; ++k) chordEnds[k] = {alongChord(-0.5f, depthRate[k]), alongChord(0.5f, depthRate[k])};
                     for (const Gathered& a : g) {
                         if (a.cls == 0 || depthRate[a.cls] == 0.f || lf.bentReach(a.pixel) > 0.f) continue;
-                        Layer& l = layers[size_t(split.layerOf(a))];
-                        if (!l.moving) continue;
+                        Layer& l = layers[size_t(split.layerOf(a))];  // (a moving layer: its class is a motion group)
                         const Vec2f q = shearOf(a, l.c, a.mx, a.my, l.depthRate);
-                        const float a0 = alongChord(-0.5f, l.depthRate), a1 = alongChord(0.5f, l.depthRate), lens = std::abs(l.c);
+                        const float a0 = chordEnds[a.cls].x, a1 = chordEnds[a.cls].y, lens = std::abs(l.c);
                         const float ex0 = q.x + a.mx * a0, ex1 = q.x + a.mx * a1, ey0 = q.y + a.my * a0, ey1 = q.y + a.my * a1;
                         if (std::max(ex0, ex1) + lens < bx0 || std::min(ex0, ex1) - lens > bx1 || std::max(ey0, ey1) + lens < by0 ||
                             std::min(ey0, ey1) - lens > by1)
