@@ -9,6 +9,7 @@
 #include <array>
 #include <cmath>
 #include <cstring>
+#include <numeric>
 #include <random>
 #include <vector>
 
@@ -2041,4 +2042,64 @@ TEST(Layers, ACrispLayersNoiseIsStillAveragedAcrossItsMotionAwayFromEdges) {
     }
     EXPECT_LT(rms[1], 0.6 * rms[2]) << "the RMS noise inside the box's trail, crisp, with the edge-stopping Gaussian against without";
     EXPECT_LT(rms[1], 1.35 * rms[0]) << "... against the grid that is not crisp";
+}
+
+TEST(Layers, ASmallMovingEmittersStreakIsItsShutterAverage) {
+    // A small emissive rectangle (0.1 x 0.4 at depth 4: an image of a x 4a pixels, a = 2.2)
+    // moving 40 px sideways over the shutter before a black wall, under a pinhole: inside its
+    // streak (rows within its height, columns a from either end) every point sees it for a / 40
+    // of the shutter, E a / 40; nothing beyond. With layers its samples carry its emission along
+    // its trajectory (render/sampling.h, LightFieldSamples::wideBlur) and no pixel is topped up
+    // for it. Measured at seeds 1-8: the interior's columns within RMS 0.5-0.6% of their mean
+    // (worst 1.8%); their mean, the light the samples found, 0.94-1.04 of the closed form, 0.993
+    // over the eight; nothing beyond; 0.15 of the rays of --layers off, which tops up the
+    // pixels whose samples saw it.
+    const char* json = R"({
+      "camera": {"position": [0, 0, 0], "look_at": [0, 0, -1], "up": [0, 1, 0], "fov_y": 40, "resolution": [64, 64]},
+      "materials": {"glow": {"albedo": [0, 0, 0], "emission": [32, 32, 32]}, "black": {"albedo": [0, 0, 0]}},
+      "lights": [{"type": "parallelogram", "corner": [100, 100, 100], "edge1": [1, 0, 0], "edge2": [0, 0, 1], "radiance": [1, 1, 1]}],
+      "objects": [{"type": "quad", "corner": [-0.96, -0.2, -4], "edge1": [0.1, 0, 0], "edge2": [0, 0.4, 0], "material": "glow", "velocity": [1.82, 0, 0]},
+                  {"type": "quad", "corner": [-10, -10, -6], "edge1": [20, 0, 0], "edge2": [0, 20, 0], "material": "black"}],
+      "render": {"spp": 16, "seed": 1, "indirect": false}
+    })";
+    const render::Camera cam(parse(json).camera);
+    const double f = cam.focalPixels(), a = 0.1 * f / 4.0, m = 1.82 * f / 4.0;
+    const double x0 = 32.0 + (-0.96) * f / 4.0, h = 0.2 * f / 4.0;  // the image's left edge at the open; half its height
+    const double inside = 32.0 * a / m;
+    double levels = 0;
+    for (int seed = 1; seed <= 8; ++seed) {
+        const render::RenderResult on = renderMc(json, "on", 16, seed);
+        std::vector<double> means;
+        double outside = 0;
+        int outsideN = 0;
+        for (int x = 0; x < 64; ++x) {
+            const bool interior = x >= x0 + a + 1.0 && x + 1 <= x0 + m - 1.0;
+            double column = 0;
+            int n = 0;
+            for (int y = 0; y < 64; ++y) {
+                const double dy = std::abs(y + 0.5 - 32.0);
+                const double v = on.color(x, y).y;
+                if (dy > h + 1.0 || x + 1 < x0 - 1.0 || x > x0 + a + m + 1.0)
+                    outside += v, ++outsideN;
+                else if (interior && dy < h - 1.0)
+                    column += v, ++n;
+            }
+            if (n > 0) means.push_back(column / n);
+        }
+        ASSERT_GT(means.size(), 25u);
+        const double level = std::accumulate(means.begin(), means.end(), 0.0) / double(means.size());
+        double worst = 0, rms = 0;
+        for (double c : means) worst = std::max(worst, std::abs(c / level - 1.0)), rms += sqr(c / level - 1.0);
+        rms = std::sqrt(rms / double(means.size()));
+        EXPECT_LT(rms, 0.015) << "seed " << seed << ": the interior's columns, of their mean";
+        EXPECT_LT(worst, 0.04) << "seed " << seed;
+        EXPECT_NEAR(level / inside, 1.0, 0.15) << "seed " << seed << ": the streak's light, of the closed form";
+        EXPECT_LT(outside / outsideN, 0.002 * inside) << "seed " << seed << ": beyond the streak";
+        levels += level / inside / 8.0;
+        if (seed == 1) {
+            const render::RenderResult off = renderMc(json, "off", 16, seed);
+            EXPECT_LT(double(on.rays), 0.3 * double(off.rays)) << "the emitter's pixels are not topped up";
+        }
+    }
+    EXPECT_NEAR(levels, 1.0, 0.04) << "the streak's light over eight seeds, of the closed form";
 }

@@ -881,7 +881,8 @@ TEST(SceneFile, DiffuseMapsWedgeCannotReadAreNamed) {
         << errorOf([&] { loadObjFile(dir + "/q.obj"); });
 }
 
-// Every scene file the docs measure on (docs/*.json, docs/lamps/*.json) loads without a warning,
+// Every scene file the docs measure on (docs/*.json, docs/lamps/*.json) loads without a warning
+// (but a moving emitter's),
 // has something to see and a light: a docs table whose scene no longer parses is a table
 // nobody can reproduce.
 TEST(Scene, EveryDocsSceneLoads) {
@@ -893,7 +894,8 @@ TEST(Scene, EveryDocsSceneLoads) {
             SCOPED_TRACE(e.path().string());
             scene::SceneDesc d;
             ASSERT_NO_THROW(d = scene::loadScene(e.path().string()));
-            EXPECT_TRUE(d.warnings.empty());
+            // (But that a moving emitter lights nothing: docs/bokeh.json has one on purpose.)
+            for (const std::string& w : d.warnings) EXPECT_NE(w.find("moving emitters are not lights"), std::string::npos) << w;
             EXPECT_GT(d.triangleCount() + d.spheres.size(), 0u);
             EXPECT_FALSE(d.lights.empty());
             ++n;

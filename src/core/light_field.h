@@ -123,7 +123,8 @@ public:
     /// `radianceScale`: radianceScaleFor(the brightest emitter) (below).
     LightFieldSamples(int width, int height, bool curved = false, float radianceScale = 1.f)
         : m_width(width), m_height(height), m_curved(curved), m_radianceScale(radianceScale),
-          m_bentReach(size_t(width) * height, 0.f) {}
+          m_bentReach(size_t(width) * height, 0.f), m_emission(size_t(width) * height, 0.f),
+          m_wideEmission(size_t(width) * height, 0.f) {}
     bool curved() const { return m_curved; }
 
     /// A sample's radiance is stored times radianceScale() (a power of two, so that the stored
@@ -211,6 +212,45 @@ public:
     float bentReach(size_t p) const { return m_bentReach[p]; }
     void markBent(size_t p, float reach) { m_bentReach[p] = std::max(m_bentReach[p], reach); }
     float* bentReachData() { return m_bentReach.data(); }
+
+    /// A sample that sees an emitter carries its emission where the emitter moves far against
+    /// its size: the segment of its screen motion, whose radius (2 sqrt of its variance per
+    /// axis, m / sqrt(3)) is at least kWideEmission pixels and kWideEmitter times the emitter's
+    /// own image (its bounding sphere's radius `size`, in pixels at the sample's depth). It is
+    /// then stored with no albedo, so that it keeps its own radiance under the filters' light
+    /// (filter/layers.h), and the layers reconstruct its emission along its trajectory: a pixel
+    /// that a small moving light crosses for a moment is found by few of its own samples (the
+    /// top-ups around an emitter reach as far as its circle of confusion, not its motion). A
+    /// still emitter's emission stays with its pixel, whose emitter edges are sampled densely
+    /// (render/methods.h, denseEmission): out of focus too, where the layers' grid softened the
+    /// crisp rim of a small emitter's disc (docs/layers.md, "Emitters through the layers").
+    /// `focalPixels` as ViewGeometry's; `objectRadius` by object id (scene::Scene::objectRadius).
+    static constexpr float kWideEmission = 4.f, kWideEmitter = 2.f;
+    void setView(float focalPixels, std::vector<float> objectRadius) {
+        m_focalPixels = focalPixels;
+        m_objectRadius = std::move(objectRadius);
+    }
+    bool wideBlur(float depth, Vec2f motion, uint32_t object) const {
+        if (object >= m_objectRadius.size()) return false;
+        const float radius2 = (motion.x * motion.x + motion.y * motion.y) / 3.f;
+        const float image = kWideEmitter * m_objectRadius[object] * m_focalPixels / std::max(depth, 1e-6f);
+        return radius2 >= kWideEmission * kWideEmission && radius2 >= image * image;
+    }
+    /// Per pixel, the emission its own samples saw (luminance, summed) and the part of it that
+    /// wide samples carry into the layers: the pixel keeps the rest of its emission
+    /// (ownEmissionShare, 1 where its samples saw none).
+    void addEmission(size_t p, float luminance, bool wide) {
+        m_emission[p] += luminance;
+        if (wide) m_wideEmission[p] += luminance;
+    }
+    /// ... replaced by another estimate of the same (render/methods.h, denseEmission).
+    void setEmission(size_t p, float luminance, float wide) { m_emission[p] = luminance, m_wideEmission[p] = wide; }
+    float ownEmissionShare(size_t p) const {
+        return m_emission[p] > 0.f ? std::max(0.f, 1.f - m_wideEmission[p] / m_emission[p]) : 1.f;
+    }
+    float* emissionData() { return m_emission.data(); }
+    float* wideEmissionData() { return m_wideEmission.data(); }
+
     /// A path that bends more than this (pixels) from its chord's line at mid-shutter is bent.
     /// AAF relMSE at 2 / 3 px against no rule, three seeds each: docs/bunny-turn.json -1..-6% /
     /// -8..-12%; a room with a bunny turning 20 degrees, a box 40 and a bar 67 -13..-25% / 0%.
@@ -223,7 +263,7 @@ public:
     static constexpr float kFaceTurn = 0.3f;
 
     size_t bytes() const {
-        size_t b = 0;  // (the samples; bentReach's 4 bytes a pixel beside them are not counted)
+        size_t b = 0;  // (the samples; bentReach's and the emissions' 12 bytes a pixel beside them are not counted)
         for (const Stage& s : m_stages) b += s.samples.size() * sampleBytes() + s.offset.size() * sizeof(uint64_t);
         return b;
     }
@@ -246,6 +286,9 @@ private:
     float m_radianceScale = 1.f;
     std::vector<Stage> m_stages;
     std::vector<float> m_bentReach;
+    std::vector<float> m_emission, m_wideEmission;
+    float m_focalPixels = 0.f;
+    std::vector<float> m_objectRadius;  // (setView)
 };
 
 }  // namespace wedge

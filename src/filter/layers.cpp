@@ -47,6 +47,9 @@ constexpr float kCrispMotion = 0.25f, kCrispSlope = 0.75f;
 // The largest cells (pixels a side) of a moving layer's grid (LayerOptions::maxGridMargin); a
 // layer that needs larger ones fits in no grid.
 constexpr int kMaxMovingStep = 8;
+// The most reconstruction rays a pixel takes (LayerOptions::rays, mixedRays, movingRays), but
+// where its tile's samples see an emitter (emitterRays, up to Rays::kMax).
+constexpr int kMaxRays = 128;
 /// A sample's screen motion counts as motion above this (pixels over the shutter).
 constexpr float kMoving = 0.5f;
 /// A tile's moving samples fall in at most this many groups of like motion, each split into
@@ -560,15 +563,25 @@ struct Layer {
     int cellIndex(Vec2f p) const { return gridCell(gx0, gy0, gw, gh, p, invStep); }
     int timeBin(float t) const { return timeBinOf(timeBins, t); }
 
+    /// The cells where a sample that sees an emitter landed (LayerOptions::emitterRays; empty
+    /// where none did), and their summed-area table as `covered`'s.
+    std::vector<uint8_t> emitCells;
+    std::vector<int> emitting;
+
     void buildCovered() {
         const int cs = cellStride();
         summedArea(gw, gh, covered, [&](int i, int j) { return cell[(size_t(j) * gw + i) * cs] > 0.f; });
+        if (!emitCells.empty()) summedArea(gw, gh, emitting, [&](int i, int j) { return emitCells[size_t(j) * gw + i] != 0; });
     }
     /// Whether any covered cell can be read by a lookup of pixel (x, y)'s rays: bilinear lookups
     /// within rayReach of the pixel's square, a sharp layer's at the pixel's own cell.
     bool reaches(int x, int y) const { return sharp ? reaches(x, y, Vec2f{}) : reaches(x, y, Vec2f{rayReach, rayReach}); }
     /// ... within r.x of the pixel's square along x and r.y along y.
-    bool reaches(int x, int y, Vec2f r) const {
+    bool reaches(int x, int y, Vec2f r) const { return reaches(covered, x, y, r); }
+    /// Whether a blurred layer's rays from pixel (x, y) can read a cell where an emitter was seen.
+    bool reachesEmitter(int x, int y) const { return !sharp && !emitting.empty() && reaches(emitting, x, y, rayExtent); }
+    /// ... any cell counted in the summed-area table `sat`.
+    bool reaches(const std::vector<int>& sat, int x, int y, Vec2f r) const {
         // (In cells: pixel x's offset from the grid's origin, gx0 step, over the cell's size.)
         const int i0 = std::max(0, int(std::floor((float(x - gx0 * step) - r.x) * invStep)) - 1);
         const int i1 = std::min(gw - 1, int(std::ceil((float(x + 1 - gx0 * step) + r.x) * invStep)) + 1);
@@ -576,7 +589,7 @@ struct Layer {
         const int j1 = std::min(gh - 1, int(std::ceil((float(y + 1 - gy0 * step) + r.y) * invStep)) + 1);
         if (i0 > i1 || j0 > j1) return false;
         const size_t s = size_t(gw + 1);
-        return covered[(j1 + 1) * s + i1 + 1] - covered[j0 * s + i1 + 1] - covered[(j1 + 1) * s + i0] + covered[j0 * s + i0] > 0;
+        return sat[(j1 + 1) * s + i1 + 1] - sat[j0 * s + i1 + 1] - sat[(j1 + 1) * s + i0] + sat[j0 * s + i0] > 0;
     }
 };
 
@@ -1590,10 +1603,14 @@ Lookup lookupSharp(const Layer& l, int x, int y, float t) {
 /// offset dt = t - 1/2, and what the layers in front gave it so far (premultiplied light,
 /// transmittance, the first layer that covered it, -1 none).
 struct Rays {
-    static constexpr int kMax = 128;
-    alignas(64) float ux[kMax], uy[kMax], u2[kMax], px[kMax], py[kMax], dt[kMax], trans[kMax];
-    alignas(64) float cr[kMax], cg[kMax], cb[kMax];
-    alignas(64) int hit[kMax];
+    static constexpr int kMax = 1024;  // (LayerOptions::emitterRays; elsewhere at most kMaxRays)
+    // Each array a cache line longer than kMax, so that ray j of the arrays does not fall in one
+    // set of the L1 cache, as it would 4 KB apart. (The stage's time with it, conference MC, one
+    // thread: as with 128 rays; not measured without it.)
+    static constexpr int kLength = kMax + 16;
+    alignas(64) float ux[kLength], uy[kLength], u2[kLength], px[kLength], py[kLength], dt[kLength], trans[kLength];
+    alignas(64) float cr[kLength], cg[kLength], cb[kLength];
+    alignas(64) int hit[kLength];
 };
 
 /// Ray j takes alpha and premultiplied light (r, g, b) of the `index`-th layer its pixel's rays
@@ -1652,7 +1669,7 @@ struct Rays {
 /// What rays [j0, j1) find on one layer: per ray its alpha and premultiplied light there,
 /// before they are composited (compositeTaken).
 struct Taken {
-    alignas(64) float alpha[Rays::kMax], r[Rays::kMax], g[Rays::kMax], b[Rays::kMax];
+    alignas(64) float alpha[Rays::kLength], r[Rays::kLength], g[Rays::kLength], b[Rays::kLength];
 };
 
 /// Rays [j0, j1) composited under layer `index`'s alpha and light as `taken` holds them
@@ -2101,6 +2118,7 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                 std::fill(lo, lo + kClasses, kInf);
                 std::fill(hi, hi + kClasses, -kInf);
                 bool anyMoving = false;
+                bool anyEmitting = false;  // a sample carries an emitter's light (LayerOptions::emitterRays)
                 const float invFocus = 1.f / view.focusDistance;  // (out of the loop: slopeAt)
                 const int rw = rx1 - rx0;
                 std::vector<uint32_t>& pixelStart = local.pixelStart;
@@ -2129,6 +2147,7 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                             a.invDepth = s.hit() ? inv : 0.f;
                             a.albedo = s.albedo;
                             a.radiance = s.radiance;
+                            anyEmitting |= s.albedo == 0u && s.radiance != 0u;
                             a.pixel = uint32_t(q);
                             a.surface = int8_t(s.surface());
                             const float c = a.c;
@@ -2208,7 +2227,8 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                     const float c = std::abs(l.c);
                     const bool own = !l.sharp && (s.surface > 0 || (!l.moving && s.surface == 0 &&
                                                                     (c >= kOwnLightAll || (mixed[s.pixel] && c >= kOwnLightSlope))));
-                    const Image3f* light = s.surface >= 0 && !own ? in.surfaceLight[s.surface] : nullptr;
+                    // (A sample with no albedo carries its own: an emitter's, its emission.)
+                    const Image3f* light = s.surface >= 0 && !own && s.albedo != 0u ? in.surfaceLight[s.surface] : nullptr;
                     return light ? unpackRgb9e5(s.albedo) * (*light)[s.pixel] : unpackRgb9e5(s.radiance) * invRadianceScale;
                 };
                 // A motion group's slope and depth over the shutter (slopeRate, depthRateOf), and
@@ -2717,7 +2737,7 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                 // radianceOf, and in a sharp layer, on a surface of a textured pixel whose samples
                 // there are all in sl, that pixel's mean albedo x its light.
                 auto splatRadiance = [&](const Gathered& s, int sl, const auto& l) {
-                    if (l.sharp && !surfaceLayer.empty() && s.surface >= 0 && in.surfaceLight[s.surface] && in.surfaceAlbedo[s.surface]) {
+                    if (l.sharp && !surfaceLayer.empty() && s.surface >= 0 && s.albedo != 0u && in.surfaceLight[s.surface] && in.surfaceAlbedo[s.surface]) {
                         const int tp = tilePixel(s);
                         if (tp >= 0 && surfaceLayer[size_t(tp) * kSurfaces + size_t(s.surface)] == sl)
                             return (*in.surfaceAlbedo[s.surface])[s.pixel] * (*in.surfaceLight[s.surface])[s.pixel];
@@ -2755,6 +2775,11 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                         m[0] += 1.f, m[1] += s.mx, m[2] += s.my;
                     }
                     splatCell(l.acc + size_t(ci) * l.accStride, l.d[ci], s.c, timeBinOf(l.timeBins, s.t), splatRadiance(s, sl, l));
+                    if (s.albedo == 0u && s.radiance != 0u && !l.sharp) {  // (LayerOptions::emitterRays)
+                        std::vector<uint8_t>& e = layers[size_t(sl)].emitCells;
+                        if (e.empty()) e.assign(size_t(l.gw) * l.gh, 0);
+                        e[size_t(ci)] = 1;
+                    }
                     if (const int tk = twinOf[size_t(sl)]; tk >= 0) {
                         // Its layer's twin: as a sharp layer takes it, at its own position.
                         Layer& t = twins[size_t(tk)];
@@ -3096,16 +3121,18 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                 std::vector<Taken> taken(1);
                 std::vector<uint8_t> isTaken;
                 // The rays' sequence before each pixel's shift: (j + 1) k_d modulo 1.
-                alignas(64) float kron[5][Rays::kMax];  // (by dimension: the rays' SIMD loop below reads them as vectors)
-                const int rays = anyBlurred ? std::clamp(o.rays, 1, Rays::kMax) : 1;
+                alignas(64) float kron[5][Rays::kLength];  // (by dimension: the rays' SIMD loop below reads them as vectors)
+                const int rays = anyBlurred ? std::clamp(o.rays, 1, kMaxRays) : 1;
                 // Where a layer moves, the rays that straddle integrate over the shutter as well,
                 // and their own noise is a larger part of the error: movingRays there
                 // (docs/layers.md, "More rays where a layer moves"; 128 for every straddling
                 // pixel measured AAF -0.3% to -4% on the five lens scenes, a wash for the time,
                 // as 128 on conference before).
                 const bool tileMoves = std::any_of(layers.begin(), layers.end(), [](const Layer& l) { return l.moving; });
-                const int mixedRays = anyBlurred ? std::clamp(tileMoves ? o.movingRays : o.mixedRays, rays, Rays::kMax) : 1;
-                for (int j = 0; j < mixedRays; ++j)
+                const int mixedRays = anyBlurred ? std::clamp(tileMoves ? o.movingRays : o.mixedRays, rays, kMaxRays) : 1;
+                // Where the tile's samples see an emitter, up to emitterRays (LayerOptions).
+                const int emitterRays = anyBlurred && anyEmitting ? std::clamp(o.emitterRays, mixedRays, Rays::kMax) : mixedRays;
+                for (int j = 0; j < emitterRays; ++j)
                     for (int d = 0; d < 5; ++d) {
                         const double v = double(j + 1) * kKronecker[d];
                         kron[d][j] = float(v - std::floor(v));
@@ -3366,6 +3393,26 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                                 trace(rays, mixedRays);
                                 pixelRays = mixedRays;
                                 ++straddling;
+                            }
+                        }
+                        if (emitterRays > pixelRays && std::any_of(active.begin(), active.end(), [&](const Active& a) { return a.layer->reachesEmitter(x, y); })) {
+                            // (LayerOptions::emitterRays) The rays it would take for its mean's
+                            // relative variance to fall to emitterTolerance, by the first ones'.
+                            double sum = 0, sum2 = 0;
+                            for (int j = 0; j < pixelRays; ++j) {
+                                const Vec3f l = rayLight(j);
+                                const double v = double(l.x + l.y + l.z) / 3.0;
+                                sum += v, sum2 += v * v;
+                            }
+                            const double n = pixelRays, mean = sum / n, variance = std::max(0.0, sum2 / n - mean * mean);
+                            const double unit = invRadianceScale;
+                            const double need = variance / (double(o.emitterTolerance) * (mean * mean + 0.01 * unit * unit));
+                            // (At least a quarter of emitterRays: a small emitter in a wide
+                            // blur can be missed by all of the first rays.)
+                            if (need > n || pixelRays < emitterRays / 4) {
+                                const int more = int(std::clamp(std::ceil(need / 32.0) * 32.0, double(emitterRays / 4), double(emitterRays)));
+                                trace(pixelRays, more);
+                                pixelRays = more;
                             }
                         }
                         Vec3f sum(0.f);

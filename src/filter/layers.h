@@ -89,8 +89,11 @@
 // still layer, on the primary surface of a pixel that saw several, where the layer's slope is
 // at least 2 px, and wherever the slope is at least 8 px, where the filtered light would blur
 // twice (layers.cpp, radianceOf).
-// Emitted light is not reconstructed here: the caller adds each pixel's own (densely sampled at
-// emitter edges).
+// Emitted light is not reconstructed here but where a small emitter moves far (a light's
+// streak: LightFieldSamples::wideBlur): there a sample that sees it carries its emission with
+// its own radiance (and no albedo, so that it keeps its own under the filters' light), and the
+// pixels within its reach take more rays (LayerOptions::emitterRays). The caller adds the rest
+// of each pixel's own emission (densely sampled at emitter edges).
 #pragma once
 
 #include <array>
@@ -165,6 +168,14 @@ struct LayerOptions {
     // (relMSE's epsilon), at least this (0: every straddling pixel; docs/layers.md, "Extra rays
     // only where the first ones disagree").
     float rayTolerance = 1e-4f;
+    // Where a pixel's rays can reach a cell where a sample that carries an emitter's light landed
+    // (one with emission carries no albedo: render/sampling.h), it takes at least a quarter of
+    // emitterRays, and more, up to emitterRays, until the same measure of its rays falls to
+    // emitterTolerance: an emitter is hundreds of times brighter than what it lights, and a
+    // small one moving far is found by few of a pixel's 32-128 rays (docs/layers.md, "Emitters
+    // through the layers").
+    int emitterRays = 1024;  // (at most Rays::kMax, 1024)
+    float emitterTolerance = 0.01f;
     uint32_t seed = 0;  // of the reconstruction rays
     // Count every sample's D on the grid of each layer in front of it, also where it lies farther
     // from all of that layer's own samples than can change the layer's coverage (the stage skips
@@ -277,7 +288,7 @@ bool samplesSharpAndStill(const LightFieldSamples& samples, size_t p, const View
 /// later; the others keep splitLayers' order. `order` receives the n layers front to back.
 void orderLayers(const uint8_t* before, int n, int* order);
 
-/// The reflected radiance (no emission) of every pixel, reconstructed from the light field.
+/// The radiance of every pixel, reconstructed from the light field.
 /// `own`, where given, is set to 1 in the pixels whose rays all end in sharp still layers (every
 /// ray finds the same values there: the pixel's own samples, composited) and, among the pixels
 /// input.textured marks kSharpTextured, in those whose first rays all end whole (no ray taking

@@ -35,7 +35,7 @@ RenderMemory renderMemory(const scene::SceneDesc& desc, const RenderOptions& opt
     // At least the initial samples; the adaptive ones are checked as they are added.
     if (spp > 0 && keepsLightField(desc, options, spp)) {
         perPixel += uint64_t(spp) * (kLightFieldSampleBytes + (keepsSags(desc) ? sizeof(LightFieldSag) : 0)) +
-                    sizeof(float);  // and LightFieldSamples::bentReach
+                    3 * sizeof(float);  // and LightFieldSamples::bentReach and the emissions
         m.what += " keeping its " + std::to_string(spp) + " samples a pixel for the layers (--layers)";
     }
     m.bytes = pixels * perPixel;

@@ -43,10 +43,10 @@ void renderAaf(const MethodContext& ctxIn, RenderResult& result) {
     filter::WedgeField wedges = filter::prefilterWedges(fb, filter::aafWedgeOptions());
     filter::AafParams params = filter::aafParams(fb, wedges, view, ao);
     Image<uint32_t> extra(W, H);
-    const Image<uint32_t> emitterExtra = emitterTopUps(stats, kEmitterEdgeSpp);
+    const Image<uint32_t> emitterExtra = emitterTopUps(stats, kEmitterEdgeSpp, ctx.lightField, ctx.sampler.distribution());
     const Image<float> pooling = blurPooling(ctx.lightField, view, bentPixels(ctx), ctx.sampler.distribution());
     const Image<uint32_t> mixedExtra = mixedTopUps(stats, pooling, ctx.luminanceUnit);
-    const Image<uint32_t> emitterEdges = emitterTopUps(stats, kEmitterEdgeRays);  // (denseEmission)
+    const Image<uint32_t> emitterEdges = emitterTopUps(stats, kEmitterEdgeRays, ctx.lightField, ctx.sampler.distribution());  // (denseEmission)
     uint64_t extraTotal = 0;
     for (size_t i = 0; i < extra.size(); ++i) {
         float need = std::max({params.sppDirect[i], params.sppIndirect[i], params.sppLens[i]});

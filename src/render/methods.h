@@ -46,8 +46,12 @@ constexpr uint32_t kEmitterEdgeSpp = 256;
 /// each pixel whose samples partly saw an emitter (PixelStats::emitterTopUp) and for each pixel
 /// within an emitter-seeing pixel's circle of confusion plus one pixel whose samples did not all
 /// see an emitter. Its 16 samples miss the few percent of a (defocused) emitter's light that
-/// reach such a rim pixel, and that light is many times the dark surface's own.
-Image<uint32_t> emitterTopUps(const PixelStatsImage& stats, uint32_t target);
+/// reach such a rim pixel, and that light is many times the dark surface's own. With the
+/// layers' samples `lf` (every rank's emissions gathered over `distribution`), only where the
+/// pixel's samples saw an emitter they do not carry into the layers (LightFieldSamples::
+/// wideBlur: a small emitter moving far).
+Image<uint32_t> emitterTopUps(const PixelStatsImage& stats, uint32_t target, LightFieldSamples* lf = nullptr,
+                              const Distribution* distribution = nullptr);
 
 /// The light-field stage of aaf's and maaf's adaptive samples (`extra` per pixel): a pixel's are
 /// kept only where its initial samples (`stats`, before the adaptive ones) saw more than one

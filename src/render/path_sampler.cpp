@@ -574,10 +574,10 @@ void PathSampler::traceMany(const SampleRun* runs, size_t nRuns, bool slopes) co
     if (lit > 0) m_lit.fetch_add(lit, std::memory_order_relaxed);
 }
 
-Vec3f PathSampler::meanEmission(int x, int y, uint32_t count) const {
+Vec3f PathSampler::meanEmission(int x, int y, uint32_t count, const LightFieldSamples* lf, Vec3f* wide) const {
     constexpr int K = scene::RayPacket::kSize;
     const PixelSampler rng(m_seed, uint32_t(y) * uint32_t(m_camera.width()) + uint32_t(x), m_independent);
-    Vec3f sum(0.f);
+    Vec3f sum(0.f), wideSum(0.f);
     for (uint32_t first = 0; first < count; first += K) {
         const int n = int(std::min<uint32_t>(K, count - first));
         scene::RayPacket primary;
@@ -588,9 +588,24 @@ Vec3f PathSampler::meanEmission(int x, int y, uint32_t count) const {
         bool found[K] = {};
         m_scene.intersect(primary, hit, found);
         for (int k = 0; k < n; ++k)
-            if (found[k] && dot(hit[k].normal, primary.dir[k]) < 0)  // emitters shine from their front
-                sum += m_scene.material(hit[k].material).emission;
+            if (found[k] && dot(hit[k].normal, primary.dir[k]) < 0) {  // emitters shine from their front
+                const Vec3f& e = m_scene.material(hit[k].material).emission;
+                sum += e;
+                if (wide && maxComponent(e) > 0.f) {
+                    // Its depth and screen motion as traceMany takes a path sample's.
+                    Vec2f motion{0.f, 0.f};
+                    if (hit[k].motion || m_camera.moving()) {
+                        const scene::RigidMotion* m = hit[k].motion;
+                        const Vec3f atOpen = m ? m->atOpen(hit[k].position, time[k]) : hit[k].position;
+                        const Vec3f atClose = m ? m->atClose(hit[k].position, time[k]) : hit[k].position;
+                        const Vec2f open = m_camera.project(atOpen, 0.f), close = m_camera.project(atClose, 1.f);
+                        motion = {close.x - open.x, close.y - open.y};
+                    }
+                    if (lf->wideBlur(m_camera.depth(hit[k].position, time[k]), motion, hit[k].object)) wideSum += e;
+                }
+            }
     }
+    if (wide) *wide = count > 0 ? wideSum / float(count) : wideSum;
     return count > 0 ? sum / float(count) : sum;
 }
 

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "core/buffers.h"
+#include "core/light_field.h"
 #include "core/sampler.h"
 #include "render/camera.h"
 #include "scene/light_irradiance.h"
@@ -108,7 +109,9 @@ public:
     /// The mean emitted radiance that the camera rays of samples 0 .. count-1 of pixel (x, y)
     /// see: the emitted part of those path samples, from their primary rays alone (no light
     /// sample, no bounce), at a fraction of their cost.
-    Vec3f meanEmission(int x, int y, uint32_t count) const;
+    /// With `wide`: the part of it whose hits are blurred wide (LightFieldSamples::wideBlur,
+    /// from each hit's depth and screen motion, as a path sample's).
+    Vec3f meanEmission(int x, int y, uint32_t count, const LightFieldSamples* lf = nullptr, Vec3f* wide = nullptr) const;
     /// The primary hits of samples first .. first+count-1 of pixel (x, y), from their camera rays
     /// alone (no light sample, no bounce): each out[k] has the fields PixelStats::slotOf and the
     /// albedo read (hit, object, normal, position, depth, albedo; rays = 1), the rest default.

@@ -29,11 +29,22 @@ void storeStats(const PixelStatsImage& stats, const MethodContext& ctx, FrameBuf
     });
 }
 
-Image<uint32_t> emitterTopUps(const PixelStatsImage& stats, uint32_t target) {
+Image<uint32_t> emitterTopUps(const PixelStatsImage& stats, uint32_t target, LightFieldSamples* lf, const Distribution* distribution) {
     const int W = stats.width(), H = stats.height();
     Image<uint32_t> extra(W, H);
+    // With layers, the pixels whose samples saw emitters only through a wide blur take none: the
+    // layers reconstruct that emission from the samples of the whole blur
+    // (LightFieldSamples::wideBlur). (Every rank's rows: the rims reach across them.)
+    if (lf) {
+        exchangeImageRows(distribution, lf->emissionData(), W, H);
+        exchangeImageRows(distribution, lf->wideEmissionData(), W, H);
+    }
+    auto seesEmitter = [&](const PixelStats& s, size_t p) { return s.nEmitter > 0 && (!lf || lf->ownEmissionShare(p) > 0.f); };
     parallelRows(H, [&](int y) {
-        for (int x = 0; x < W; ++x) extra(x, y) = stats(x, y).emitterTopUp(target);
+        for (int x = 0; x < W; ++x) {
+            const size_t p = size_t(y) * W + x;
+            extra[p] = seesEmitter(stats[p], p) ? stats[p].emitterTopUp(target) : 0;
+        }
     });
     // Emitter-seeing pixels are few (an emitter's image): scatter their rims serially. Measured
     // (512x512, relMSE against 1024-spp references, without -> with the rims): cornell aaf
@@ -43,7 +54,7 @@ Image<uint32_t> emitterTopUps(const PixelStatsImage& stats, uint32_t target) {
     for (int y = 0; y < H; ++y)
         for (int x = 0; x < W; ++x) {
             const PixelStats& s = stats(x, y);
-            if (s.nEmitter == 0) continue;
+            if (!seesEmitter(s, size_t(y) * W + x)) continue;
             const float coc = s.suLo <= s.suHi ? std::max(std::abs(s.suLo), std::abs(s.suHi)) : 0.f;
             const int r = std::min(kMaxRim, int(std::ceil(coc)) + 1);
             for (int yy = std::max(0, y - r); yy <= std::min(H - 1, y + r); ++yy)
@@ -55,20 +66,19 @@ Image<uint32_t> emitterTopUps(const PixelStatsImage& stats, uint32_t target) {
     return extra;
 }
 
-Image<uint8_t> bentPixels(const MethodContext& ctx) {
-    if (!ctx.lightField) return {};
-    LightFieldSamples& lf = *ctx.lightField;
-    const int W = lf.width(), H = lf.height();
-    // The squares around the bent samples' pixels, through a difference table: +1 and -1 at
-    // their corners, then sums along the rows and the columns.
-    exchangeImageRows(ctx.sampler.distribution(), lf.bentReachData(), W, H);
+namespace {
+
+/// The pixels within reach[p] (pixels, a square) of a pixel p with reach[p] > 0; empty where
+/// there is none. Through a difference table: +1 and -1 at the squares' corners, then sums along
+/// the rows and the columns.
+Image<uint8_t> squaresAround(const float* reach, int W, int H) {
     std::vector<int32_t> cover;
     for (int y = 0; y < H; ++y)
         for (int x = 0; x < W; ++x) {
-            const float reach = lf.bentReach(size_t(y) * W + x);
-            if (!(reach > 0.f)) continue;
+            const float r0 = reach[size_t(y) * W + x];
+            if (!(r0 > 0.f)) continue;
             if (cover.empty()) cover.assign(size_t(W + 1) * (H + 1), 0);
-            const int r = int(std::ceil(std::min(reach, float(W + H))));
+            const int r = int(std::ceil(std::min(r0, float(W + H))));
             const int x0 = std::max(0, x - r), x1 = std::min(W, x + r + 1), y0 = std::max(0, y - r), y1 = std::min(H, y + r + 1);
             cover[size_t(y0) * (W + 1) + x0] += 1, cover[size_t(y0) * (W + 1) + x1] -= 1;
             cover[size_t(y1) * (W + 1) + x0] -= 1, cover[size_t(y1) * (W + 1) + x1] += 1;
@@ -78,10 +88,21 @@ Image<uint8_t> bentPixels(const MethodContext& ctx) {
         for (int x = 1; x <= W; ++x) cover[size_t(y) * (W + 1) + x] += cover[size_t(y) * (W + 1) + x - 1];
     for (int y = 1; y <= H; ++y)
         for (int x = 0; x <= W; ++x) cover[size_t(y) * (W + 1) + x] += cover[size_t(y - 1) * (W + 1) + x];
-    Image<uint8_t> bent(W, H);
+    Image<uint8_t> in(W, H);
     for (int y = 0; y < H; ++y)
-        for (int x = 0; x < W; ++x) bent(x, y) = cover[size_t(y) * (W + 1) + x] > 0;
-    return bent;
+        for (int x = 0; x < W; ++x) in(x, y) = cover[size_t(y) * (W + 1) + x] > 0;
+    return in;
+}
+
+}  // namespace
+
+Image<uint8_t> bentPixels(const MethodContext& ctx) {
+    if (!ctx.lightField) return {};
+    LightFieldSamples& lf = *ctx.lightField;
+    const int W = lf.width(), H = lf.height();
+    // The squares around the bent samples' pixels.
+    exchangeImageRows(ctx.sampler.distribution(), lf.bentReachData(), W, H);
+    return squaresAround(lf.bentReachData(), W, H);
 }
 
 Image<float> blurPooling(const LightFieldSamples* lightField, const ViewGeometry& view, const Image<uint8_t>& bent,
@@ -197,7 +218,12 @@ uint64_t denseEmission(const MethodContext& ctx, const Image<uint32_t>& topUp, F
         for (int x = 0; x < fb.width; ++x) {
             const size_t p = size_t(y) * fb.width + x;
             if (topUp[p] == 0) continue;
-            const Vec3f e = ctx.sampler.meanEmission(x, y, kEmitterEdgeRays);
+            // (The part that the layers take, where they do: the rays' hits that a sample would
+            // carry into them, LightFieldSamples::wideBlur. A rim pixel whose own samples saw no
+            // emitter is topped up too.)
+            Vec3f wide(0.f);
+            const Vec3f e = ctx.sampler.meanEmission(x, y, kEmitterEdgeRays, ctx.lightField, ctx.lightField ? &wide : nullptr);
+            if (ctx.lightField) ctx.lightField->setEmission(p, (e.x + e.y + e.z) / 3.f, (wide.x + wide.y + wide.z) / 3.f);
             fb.color[p] += e - fb.emission[p];
             fb.emission[p] = e;
             local += kEmitterEdgeRays;
@@ -206,6 +232,10 @@ uint64_t denseEmission(const MethodContext& ctx, const Image<uint32_t>& topUp, F
     });
     exchangeImageRows(ctx.sampler.distribution(), fb.color.data(), fb.width, fb.height);
     exchangeImageRows(ctx.sampler.distribution(), fb.emission.data(), fb.width, fb.height);
+    if (ctx.lightField) {
+        exchangeImageRows(ctx.sampler.distribution(), ctx.lightField->emissionData(), fb.width, fb.height);
+        exchangeImageRows(ctx.sampler.distribution(), ctx.lightField->wideEmissionData(), fb.width, fb.height);
+    }
     return rays;
 }
 
@@ -243,6 +273,28 @@ void leavePixelsToTheMethod(const MethodContext& ctx, const PixelStatsImage& sta
     const Image<uint8_t> bent = bentPixels(ctx);
     for (size_t p = 0; p < bent.size(); ++p)
         if (bent[p]) result.methodPixels[p] = 1;
+
+    // And none within reach of a sample that carries an emitter's light into the layers
+    // (LightFieldSamples::wideBlur), which no pixel tops up: the method's own image has that
+    // light only in the pixels whose few samples saw it. Its reach: its blur's (the lens's
+    // disc and half its motion) twice, from its sharp position to the pixel and to the blur's
+    // far side.
+    Image1f reach(W, H);
+    parallelRows(H, [&](int y) {
+        if (!ctx.sampler.tracesRow(y)) return;
+        for (size_t p = size_t(y) * W; p < size_t(y + 1) * W; ++p) {
+            if (!(lf.wideEmissionData()[p] > 0.f)) continue;
+            lf.forEach(p, [&](const LightFieldSample& s) {
+                if (s.albedo != 0u || s.radiance == 0u) return;
+                const Vec2f m = s.motion();
+                reach[p] = std::max(reach[p], 2.f * (std::abs(ctx.view.defocusSlope(s.depth)) + 0.5f * std::sqrt(m.x * m.x + m.y * m.y)) + 1.f);
+            });
+        }
+    });
+    exchangeImageRows(ctx.sampler.distribution(), reach.data(), W, H);
+    const Image<uint8_t> lit = squaresAround(reach.data(), W, H);
+    for (size_t p = 0; p < lit.size(); ++p)
+        if (lit[p]) result.methodPixels[p] = 0;
 }
 
 }  // namespace
@@ -307,6 +359,9 @@ void finishLightField(const MethodContext& ctx, const PixelStatsImage& stats) {
     if (!ctx.lightField) return;
     LightFieldSamples& lf = *ctx.lightField;
     exchangeLightField(ctx.sampler.distribution(), lf);  // each rank recorded its own rows' samples
+    // ... and their emissions (LightFieldSamples::ownEmissionShare).
+    exchangeImageRows(ctx.sampler.distribution(), lf.emissionData(), lf.width(), lf.height());
+    exchangeImageRows(ctx.sampler.distribution(), lf.wideEmissionData(), lf.width(), lf.height());
     parallelRows(lf.height(), [&](int y) {
         for (int x = 0; x < lf.width(); ++x) {
             const size_t p = size_t(y) * lf.width() + x;
@@ -411,9 +466,12 @@ Image3f reconstructFromLayers(const MethodContext& ctx,
     }
     Image3f color = filter::reconstructLayers(input, lo, &stats, perPixel ? &own : nullptr);
     const size_t ownPixels = size_t(std::count(own.data(), own.data() + own.size(), uint8_t(1)));  // (empty without perPixel)
+    // The samples that see an emitter through a wide blur carry its emission into the
+    // reconstruction; each pixel adds the rest of its own (LightFieldSamples::wideBlur).
+    const LightFieldSamples& lf = *ctx.lightField;
     parallelRows(fb.height, [&](int y) {
         for (size_t p = size_t(y) * fb.width; p < size_t(y + 1) * fb.width; ++p)
-            color[p] = perPixel && own[p] ? (*perPixel)[p] : color[p] + fb.emission[p];
+            color[p] = perPixel && own[p] ? (*perPixel)[p] : color[p] + fb.emission[p] * lf.ownEmissionShare(p);
     });
     result.seconds.add("layers", t.seconds());
     result.extra.emplace_back("layers_sample_bytes", double(ctx.lightField->bytes()));
@@ -462,8 +520,8 @@ void sampleUniform(const MethodContext& ctx, const std::string& label, RenderRes
         [&](int x, int y, const TracedSample& s, int slot) { initial.record(x, y, s, slot); }, &progress);
     progress.done();
     // Pixels at the edge of a visible emitter get topped up, as in every method.
-    const Image<uint32_t> topUp = emitterTopUps(stats, kEmitterEdgeSpp);
-    const Image<uint32_t> edges = emitterTopUps(stats, kEmitterEdgeRays);  // (denseEmission)
+    const Image<uint32_t> topUp = emitterTopUps(stats, kEmitterEdgeSpp, ctx.lightField, ctx.sampler.distribution());
+    const Image<uint32_t> edges = emitterTopUps(stats, kEmitterEdgeRays, ctx.lightField, ctx.sampler.distribution());  // (denseEmission)
     LightFieldStage more(ctx.lightField, [&](size_t p) { return topUp[p]; });
     result.rays += samplePixels(
         ctx.sampler, stats, view,
@@ -525,7 +583,11 @@ RenderResult render(const scene::Scene& scene, const RenderOptions& options) {
         throw Error("--layers", "expected auto, on or off, got '" + options.layers + "'");
     const bool layered = keepsLightField(desc, options, spp);
     const float radianceScale = LightFieldSamples::radianceScaleFor(brightestEmitter(desc));
-    if (layered) lightField = LightFieldSamples(desc.camera.width, desc.camera.height, keepsSags(desc), radianceScale);
+    if (layered) {
+        lightField = LightFieldSamples(desc.camera.width, desc.camera.height, keepsSags(desc), radianceScale);
+        const ViewGeometry& v = sampler.view();
+        lightField.setView(v.focalPixels, scene.objectRadius());
+    }
     MethodContext ctx{scene, options, sampler, sampler.view(), spp, layered ? &lightField : nullptr, 1.f / radianceScale};
 
     RenderResult result;

@@ -37,12 +37,20 @@ public:
     void record(int x, int y, const TracedSample& s, int slot) {
         if (!m_lf) return;
         const size_t p = size_t(y) * m_lf->width() + x;
+        // A sample that sees an emitter through a wide blur carries its emission too, and no
+        // albedo: its radiance is then its own everywhere, where the filters' light (albedo x
+        // the surface's filtered light) would drop the emission (LightFieldSamples::wideBlur).
+        // Its pixel's emission counts it, kept or not, as the pixel's statistics do.
+        const float emitted = (s.emission.x + s.emission.y + s.emission.z) / 3.f;
+        const bool wide = emitted > 0.f && m_lf->wideBlur(s.depth, s.motion, s.object);
+        if (emitted > 0.f) m_lf->addEmission(p, emitted, wide);
         if (m_fill[p] == m_lf->runLength(m_stage, p)) return;
         const SampleRecord& r = s.record;
         if (m_lf->curved()) m_lf->sagRun(m_stage, p)[m_fill[p]] = LightFieldSag::pack(s.sag);
-        m_lf->run(m_stage, p)[m_fill[p]++] = LightFieldSample::pack(
-            s.film, r.lens, s.time, s.hit ? s.depth : kInf, s.motion, s.albedo,
-            s.albedo * (r.direct + r.indirect) * m_lf->radianceScale(), slot);
+        Vec3f radiance = s.albedo * (r.direct + r.indirect);
+        if (wide) radiance += s.emission;
+        m_lf->run(m_stage, p)[m_fill[p]++] = LightFieldSample::pack(s.film, r.lens, s.time, s.hit ? s.depth : kInf, s.motion,
+                                                                    wide ? Vec3f(0.f) : s.albedo, radiance * m_lf->radianceScale(), slot);
         // A bent path on a surface that turns towards or away from the camera (render/renderer.cpp,
         // leavePixelsToTheMethod). The sample lands in its layer's sharp image within |m| / 2 of
         // x, where a ray of a pixel within |m| / 2 of it reads it; the bend and the grid's blur
