@@ -97,6 +97,10 @@ struct LightFieldSample {
         timeSurface = uint16_t((timeSurface & 0x3fffu) | (uint32_t(std::clamp(surface + 1, 0, 3)) << 14));
     }
     bool hit() const { return depth < kInf; }
+    /// Whether a sample with these (packed) albedo and radiance carries an emitter's light: one
+    /// with no albedo and some radiance (LightFieldSamples::wideBlur).
+    static bool carriesEmission(uint32_t albedo, uint32_t radiance) { return albedo == 0u && radiance != 0u; }
+    bool carriesEmission() const { return carriesEmission(albedo, radiance); }
 };
 static_assert(sizeof(LightFieldSample) == 24);
 /// Where a turning object's point is at mid-shutter on the screen, off its path's chord's middle

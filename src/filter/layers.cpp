@@ -2147,7 +2147,7 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                             a.invDepth = s.hit() ? inv : 0.f;
                             a.albedo = s.albedo;
                             a.radiance = s.radiance;
-                            anyEmitting |= s.albedo == 0u && s.radiance != 0u;
+                            anyEmitting |= s.carriesEmission();
                             a.pixel = uint32_t(q);
                             a.surface = int8_t(s.surface());
                             const float c = a.c;
@@ -2775,7 +2775,7 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                         m[0] += 1.f, m[1] += s.mx, m[2] += s.my;
                     }
                     splatCell(l.acc + size_t(ci) * l.accStride, l.d[ci], s.c, timeBinOf(l.timeBins, s.t), splatRadiance(s, sl, l));
-                    if (s.albedo == 0u && s.radiance != 0u && !l.sharp) {  // (LayerOptions::emitterRays)
+                    if (LightFieldSample::carriesEmission(s.albedo, s.radiance) && !l.sharp) {  // (LayerOptions::emitterRays)
                         std::vector<uint8_t>& e = layers[size_t(sl)].emitCells;
                         if (e.empty()) e.assign(size_t(l.gw) * l.gh, 0);
                         e[size_t(ci)] = 1;
@@ -3377,17 +3377,27 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                             const float t = ray.trans[j];
                             return t > 1e-4f && t < 1.f ? c / (1.f - t) : c;
                         };
+                        // The variance of the luminance of rays [0, n) and their mean's square
+                        // plus relMSE's 0.01 (in the stored radiance's unit), whose ratio over n is
+                        // the relative variance of the mean.
+                        struct Spread {
+                            double variance, scale;
+                        };
+                        auto spreadOf = [&](int n) {
+                            double sum = 0, sum2 = 0;
+                            for (int j = 0; j < n; ++j) {
+                                const Vec3f l = rayLight(j);
+                                const double v = double(l.x + l.y + l.z) / 3.0;
+                                sum += v, sum2 += v * v;
+                            }
+                            const double mean = sum / n, variance = std::max(0.0, sum2 / n - mean * mean);
+                            const double unit = invRadianceScale;
+                            return Spread{variance, mean * mean + 0.01 * unit * unit};
+                        };
                         if (pixelRays == rays && mixedRays > rays) {
                             if (straddles && o.rayTolerance > 0.f) {
-                                double sum = 0, sum2 = 0;
-                                for (int j = 0; j < rays; ++j) {
-                                    const Vec3f l = rayLight(j);
-                                    const double v = double(l.x + l.y + l.z) / 3.0;
-                                    sum += v, sum2 += v * v;
-                                }
-                                const double mean = sum / rays, variance = std::max(0.0, sum2 / rays - mean * mean);
-                                const double unit = invRadianceScale;
-                                straddles = variance >= double(o.rayTolerance) * double(rays) * (mean * mean + 0.01 * unit * unit);
+                                const Spread v = spreadOf(rays);
+                                straddles = v.variance >= double(o.rayTolerance) * double(rays) * v.scale;
                             }
                             if (straddles) {
                                 trace(rays, mixedRays);
@@ -3398,15 +3408,8 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                         if (emitterRays > pixelRays && std::any_of(active.begin(), active.end(), [&](const Active& a) { return a.layer->reachesEmitter(x, y); })) {
                             // (LayerOptions::emitterRays) The rays it would take for its mean's
                             // relative variance to fall to emitterTolerance, by the first ones'.
-                            double sum = 0, sum2 = 0;
-                            for (int j = 0; j < pixelRays; ++j) {
-                                const Vec3f l = rayLight(j);
-                                const double v = double(l.x + l.y + l.z) / 3.0;
-                                sum += v, sum2 += v * v;
-                            }
-                            const double n = pixelRays, mean = sum / n, variance = std::max(0.0, sum2 / n - mean * mean);
-                            const double unit = invRadianceScale;
-                            const double need = variance / (double(o.emitterTolerance) * (mean * mean + 0.01 * unit * unit));
+                            const Spread v = spreadOf(pixelRays);
+                            const double n = pixelRays, need = v.variance / (double(o.emitterTolerance) * v.scale);
                             // (At least a quarter of emitterRays: a small emitter in a wide
                             // blur can be missed by all of the first rays.)
                             if (need > n || pixelRays < emitterRays / 4) {

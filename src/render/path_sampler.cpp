@@ -256,6 +256,13 @@ void PathSampler::setPrimaryHit(TracedSample& o, const scene::Hit& hit, const Ve
     o.object = hit.object;
 }
 
+PathSampler::ShutterPath PathSampler::shutterPath(const scene::Hit& hit, float time) const {
+    const scene::RigidMotion* m = hit.motion;
+    const Vec3f atOpen = m ? m->atOpen(hit.position, time) : hit.position;
+    const Vec3f atClose = m ? m->atClose(hit.position, time) : hit.position;
+    return {atOpen, atClose, m_camera.project(atOpen, 0.f), m_camera.project(atClose, 1.f)};
+}
+
 void PathSampler::cameraRays(const PixelSampler& rng, int x, int y, uint32_t first, int n, scene::RayPacket& primary,
                              Vec2f* lens, float* choice, float* time, Vec2f* uLight, Vec2f* film) const {
     constexpr int K = scene::RayPacket::kSize;
@@ -422,15 +429,12 @@ void PathSampler::traceMany(const SampleRun* runs, size_t nRuns, bool slopes) co
                 setPrimaryHit(o, hit, w.geometric[l], w.time[l]);
                 w.normal[l] = o.normal;
                 if (hit.motion || m_camera.moving()) {
-                    // The hit point's path over the shutter, through the lens centre (of the
-                    // camera where it is when the shutter opens and where when it closes): from
-                    // where the point is at the open to where at the close, a chord of its arc
-                    // where the object turns.
-                    const float t = w.time[l];
+                    // The hit point's path over the shutter (shutterPath).
                     const scene::RigidMotion* m = hit.motion;
-                    const Vec3f atOpen = m ? m->atOpen(hit.position, t) : hit.position;
-                    const Vec3f atClose = m ? m->atClose(hit.position, t) : hit.position;
-                    const Vec2f open = m_camera.project(atOpen, 0.f), close = m_camera.project(atClose, 1.f);
+                    const ShutterPath path = shutterPath(hit, w.time[l]);
+                    const float t = w.time[l];
+                    const Vec3f &atOpen = path.atOpen, &atClose = path.atClose;
+                    const Vec2f open = path.open, close = path.close;
                     o.motion = {close.x - open.x, close.y - open.y};
                     // Where it is at mid-shutter, off the chord's line: the sagitta of an arc,
                     // r (1 - cos(a / 2)) for a turn of a in the image plane. (Along the line a
@@ -595,11 +599,8 @@ Vec3f PathSampler::meanEmission(int x, int y, uint32_t count, const LightFieldSa
                     // Its depth and screen motion as traceMany takes a path sample's.
                     Vec2f motion{0.f, 0.f};
                     if (hit[k].motion || m_camera.moving()) {
-                        const scene::RigidMotion* m = hit[k].motion;
-                        const Vec3f atOpen = m ? m->atOpen(hit[k].position, time[k]) : hit[k].position;
-                        const Vec3f atClose = m ? m->atClose(hit[k].position, time[k]) : hit[k].position;
-                        const Vec2f open = m_camera.project(atOpen, 0.f), close = m_camera.project(atClose, 1.f);
-                        motion = {close.x - open.x, close.y - open.y};
+                        const ShutterPath path = shutterPath(hit[k], time[k]);
+                        motion = {path.close.x - path.open.x, path.close.y - path.open.y};
                     }
                     if (lf->wideBlur(m_camera.depth(hit[k].position, time[k]), motion, hit[k].object)) wideSum += e;
                 }

@@ -178,6 +178,15 @@ private:
     /// PixelStats::slotOf compares, so traceMany and primaryHits must take it alike. The depth is
     /// from the camera where it is at the sample's shutter time `time` (a moving camera).
     void setPrimaryHit(TracedSample& o, const scene::Hit& hit, const Vec3f& geometric, float time) const;
+    /// The path over the shutter of a camera ray's hit at shutter time `time`, through the lens
+    /// centre (of the camera where it is when the shutter opens and where when it closes): the
+    /// point at the open and at the close, in the world and on the screen. Its screen motion
+    /// (TracedSample::motion) is close - open, a chord of its arc where the object turns.
+    struct ShutterPath {
+        Vec3f atOpen, atClose;
+        Vec2f open, close;
+    };
+    ShutterPath shutterPath(const scene::Hit& hit, float time) const;
     /// The camera rays of samples first .. first+n-1 (n <= 16) of a pixel into `primary`, with
     /// each sample's lens point, light choice and shutter time, and (unless null) the point it
     /// samples on the light, drawn with the choice and time: what traceBatch and meanEmission

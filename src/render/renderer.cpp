@@ -285,7 +285,7 @@ void leavePixelsToTheMethod(const MethodContext& ctx, const PixelStatsImage& sta
         for (size_t p = size_t(y) * W; p < size_t(y + 1) * W; ++p) {
             if (!(lf.wideEmissionData()[p] > 0.f)) continue;
             lf.forEach(p, [&](const LightFieldSample& s) {
-                if (s.albedo != 0u || s.radiance == 0u) return;
+                if (!s.carriesEmission()) return;
                 const Vec2f m = s.motion();
                 reach[p] = std::max(reach[p], 2.f * (std::abs(ctx.view.defocusSlope(s.depth)) + 0.5f * std::sqrt(m.x * m.x + m.y * m.y)) + 1.f);
             });
