@@ -586,7 +586,10 @@ RenderResult render(const scene::Scene& scene, const RenderOptions& options) {
     if (layered) {
         lightField = LightFieldSamples(desc.camera.width, desc.camera.height, keepsSags(desc), radianceScale);
         const ViewGeometry& v = sampler.view();
-        lightField.setView(v.focalPixels, scene.objectRadius());
+        const auto along = [](Vec3f h, Vec3f axis) { return std::abs(h.x * axis.x) + std::abs(h.y * axis.y) + std::abs(h.z * axis.z); };
+        std::vector<Vec2f> image;
+        for (const Vec3f& h : scene.objectHalfExtents()) image.push_back({along(h, v.right), along(h, v.up)});
+        lightField.setView(v.focalPixels, v.apertureRadius * v.focalPixels, 1.f / v.focusDistance, std::move(image));
     }
     MethodContext ctx{scene, options, sampler, sampler.view(), spp, layered ? &lightField : nullptr, 1.f / radianceScale};
 

@@ -127,7 +127,7 @@ Scene::Scene(SceneDesc desc) : m_desc(std::move(desc)) {
                           motion.moves(), motion.turns()};
         uint32_t shapes = 0;
         for (uint32_t sId : mesh.shapeIds) shapes = std::max(shapes, sId + 1);
-        // Each shape's bounds at shutter open (objectRadius).
+        // Each shape's bounds at shutter open (objectHalfExtents).
         std::vector<Vec3f> lo(std::max(shapes, 1u), Vec3f(kInf)), hi(std::max(shapes, 1u), Vec3f(-kInf));
         for (size_t t = 0; t < mesh.triangleCount(); ++t) {
             const uint32_t k = mesh.shapeIds.empty() ? 0u : mesh.shapeIds[t];
@@ -136,7 +136,8 @@ Scene::Scene(SceneDesc desc) : m_desc(std::move(desc)) {
                 lo[k] = vmin(lo[k], p), hi[k] = vmax(hi[k], p);
             }
         }
-        for (uint32_t k = 0; k < std::max(shapes, 1u); ++k) m_objectRadius.push_back(lo[k].x <= hi[k].x ? 0.5f * length(hi[k] - lo[k]) : 0.f);
+        for (uint32_t k = 0; k < std::max(shapes, 1u); ++k)
+            m_objectHalfExtents.push_back(lo[k].x <= hi[k].x ? (hi[k] - lo[k]) * 0.5f : Vec3f(0.f));
         object += std::max(shapes, 1u);
         m_objectMoves.resize(object, uint8_t(moving));
     }
@@ -169,7 +170,7 @@ Scene::Scene(SceneDesc desc) : m_desc(std::move(desc)) {
         m_geometry[id].moves = moving;
         object += uint32_t(m_desc.spheres.size());
         for (auto& s : m_desc.spheres) m_objectMoves.push_back(s.velocity * shutter != Vec3f(0.f));
-        for (auto& s : m_desc.spheres) m_objectRadius.push_back(s.radius);
+        for (auto& s : m_desc.spheres) m_objectHalfExtents.push_back(Vec3f(s.radius));
     }
     rtcCommitScene(m_scene);
     if (rtcGetDeviceError(m_device) != RTC_ERROR_NONE) throw Error("Embree: failed to build the scene");

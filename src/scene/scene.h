@@ -81,9 +81,9 @@ public:
     /// By object id (Hit::object, FrameBuffers::object): 1 where that object moves or turns over
     /// the shutter (the camera's motion aside).
     const std::vector<uint8_t>& objectMoves() const { return m_objectMoves; }
-    /// By object id: the radius of its bounding sphere (half its bounding box's diagonal, at
-    /// shutter open; a sphere's own radius).
-    const std::vector<float>& objectRadius() const { return m_objectRadius; }
+    /// By object id: half its world bounding box's extent along each axis, at shutter open (a
+    /// sphere's own radius on each).
+    const std::vector<Vec3f>& objectHalfExtents() const { return m_objectHalfExtents; }
 
     /// time in [0, 1] over the shutter.
     bool intersect(const Vec3f& org, const Vec3f& dir, float tNear, float tFar, float time, Hit& hit) const;
@@ -135,7 +135,7 @@ private:
     std::vector<uint32_t> m_sphereMaterials;
     std::vector<RigidMotion> m_sphereMotion;  // by primitive, where a sphere moves (else empty)
     std::vector<uint8_t> m_objectMoves;       // objectMoves()
-    std::vector<float> m_objectRadius;        // objectRadius()
+    std::vector<Vec3f> m_objectHalfExtents;   // objectHalfExtents()
     Vec3f m_lo{kInf}, m_hi{-kInf};
     float m_extent = 1.f;
 };
