@@ -43,10 +43,11 @@ void renderAaf(const MethodContext& ctxIn, RenderResult& result) {
     filter::WedgeField wedges = filter::prefilterWedges(fb, filter::aafWedgeOptions());
     filter::AafParams params = filter::aafParams(fb, wedges, view, ao);
     Image<uint32_t> extra(W, H);
-    const Image<uint32_t> emitterExtra = emitterTopUps(stats, kEmitterEdgeSpp, ctx.lightField, ctx.sampler.distribution());
+    shareEmissions(ctx.lightField, ctx.sampler.distribution());
+    const Image<uint32_t> emitterExtra = emitterTopUps(stats, kEmitterEdgeSpp, ctx.lightField);
     const Image<float> pooling = blurPooling(ctx.lightField, view, bentPixels(ctx), ctx.sampler.distribution());
     const Image<uint32_t> mixedExtra = mixedTopUps(stats, pooling, ctx.luminanceUnit);
-    const Image<uint32_t> emitterEdges = emitterTopUps(stats, kEmitterEdgeRays, ctx.lightField, ctx.sampler.distribution());  // (denseEmission)
+    const Image<uint32_t> emitterEdges = emitterTopUps(stats, kEmitterEdgeRays, ctx.lightField);  // (denseEmission)
     uint64_t extraTotal = 0;
     for (size_t i = 0; i < extra.size(); ++i) {
         float need = std::max({params.sppDirect[i], params.sppIndirect[i], params.sppLens[i]});

@@ -236,10 +236,11 @@ void renderMaaf(const MethodContext& ctxIn, RenderResult& result) {
     const filter::AafOptions ao;
     const filter::AafParams rates = filter::aafParams(fb, wedges, view, ao);
     Image<uint32_t> extra(W, H);
-    const Image<uint32_t> emitterExtra = emitterTopUps(stats, kEmitterEdgeSpp, ctx.lightField, ctx.sampler.distribution());
+    shareEmissions(ctx.lightField, ctx.sampler.distribution());
+    const Image<uint32_t> emitterExtra = emitterTopUps(stats, kEmitterEdgeSpp, ctx.lightField);
     const Image<float> pooling = blurPooling(ctx.lightField, view, bentPixels(ctx), ctx.sampler.distribution());
     const Image<uint32_t> mixedExtra = mixedTopUps(stats, pooling, ctx.luminanceUnit);
-    const Image<uint32_t> emitterEdges = emitterTopUps(stats, kEmitterEdgeRays, ctx.lightField, ctx.sampler.distribution());  // (denseEmission)
+    const Image<uint32_t> emitterEdges = emitterTopUps(stats, kEmitterEdgeRays, ctx.lightField);  // (denseEmission)
     uint64_t extraTotal = 0;
     // Whether an effect's filter at pixel p has outer components on either image axis.
     auto outerComponents = [](const filter::MaafEffect& effect, size_t p) { return effect.pairs(p, 0) > 1 || effect.pairs(p, 1) > 1; };

@@ -47,11 +47,13 @@ constexpr uint32_t kEmitterEdgeSpp = 256;
 /// within an emitter-seeing pixel's circle of confusion plus one pixel whose samples did not all
 /// see an emitter. Its 16 samples miss the few percent of a (defocused) emitter's light that
 /// reach such a rim pixel, and that light is many times the dark surface's own. With the
-/// layers' samples `lf` (every rank's emissions gathered over `distribution`), only where the
+/// layers' samples `lf` (every rank's emissions gathered first: shareEmissions), only where the
 /// pixel's samples saw an emitter they do not carry into the layers (LightFieldSamples::
-/// wideBlur: a small emitter moving far).
-Image<uint32_t> emitterTopUps(const PixelStatsImage& stats, uint32_t target, LightFieldSamples* lf = nullptr,
-                              const Distribution* distribution = nullptr);
+/// wideBlur: a moving light spread thin over its blur).
+Image<uint32_t> emitterTopUps(const PixelStatsImage& stats, uint32_t target, const LightFieldSamples* lf = nullptr);
+/// Gives every rank the per-pixel emission sums of the others' rows (LightFieldSamples::
+/// emissionData, wideEmissionData), which emitterTopUps reads across them; nothing without `lf`.
+void shareEmissions(LightFieldSamples* lf, const Distribution* distribution);
 
 /// The light-field stage of aaf's and maaf's adaptive samples (`extra` per pixel): a pixel's are
 /// kept only where its initial samples (`stats`, before the adaptive ones) saw more than one

@@ -29,16 +29,18 @@ void storeStats(const PixelStatsImage& stats, const MethodContext& ctx, FrameBuf
     });
 }
 
-Image<uint32_t> emitterTopUps(const PixelStatsImage& stats, uint32_t target, LightFieldSamples* lf, const Distribution* distribution) {
+void shareEmissions(LightFieldSamples* lf, const Distribution* distribution) {
+    if (!lf) return;
+    exchangeImageRows(distribution, lf->emissionData(), lf->width(), lf->height());
+    exchangeImageRows(distribution, lf->wideEmissionData(), lf->width(), lf->height());
+}
+
+Image<uint32_t> emitterTopUps(const PixelStatsImage& stats, uint32_t target, const LightFieldSamples* lf) {
     const int W = stats.width(), H = stats.height();
     Image<uint32_t> extra(W, H);
     // With layers, the pixels whose samples saw emitters only through a wide blur take none: the
     // layers reconstruct that emission from the samples of the whole blur
-    // (LightFieldSamples::wideBlur). (Every rank's rows: the rims reach across them.)
-    if (lf) {
-        exchangeImageRows(distribution, lf->emissionData(), W, H);
-        exchangeImageRows(distribution, lf->wideEmissionData(), W, H);
-    }
+    // (LightFieldSamples::wideBlur). (Every rank's rows, shareEmissions: the rims reach across them.)
     auto seesEmitter = [&](const PixelStats& s, size_t p) { return s.nEmitter > 0 && (!lf || lf->ownEmissionShare(p) > 0.f); };
     parallelRows(H, [&](int y) {
         for (int x = 0; x < W; ++x) {
@@ -520,8 +522,9 @@ void sampleUniform(const MethodContext& ctx, const std::string& label, RenderRes
         [&](int x, int y, const TracedSample& s, int slot) { initial.record(x, y, s, slot); }, &progress);
     progress.done();
     // Pixels at the edge of a visible emitter get topped up, as in every method.
-    const Image<uint32_t> topUp = emitterTopUps(stats, kEmitterEdgeSpp, ctx.lightField, ctx.sampler.distribution());
-    const Image<uint32_t> edges = emitterTopUps(stats, kEmitterEdgeRays, ctx.lightField, ctx.sampler.distribution());  // (denseEmission)
+    shareEmissions(ctx.lightField, ctx.sampler.distribution());
+    const Image<uint32_t> topUp = emitterTopUps(stats, kEmitterEdgeSpp, ctx.lightField);
+    const Image<uint32_t> edges = emitterTopUps(stats, kEmitterEdgeRays, ctx.lightField);  // (denseEmission)
     LightFieldStage more(ctx.lightField, [&](size_t p) { return topUp[p]; });
     result.rays += samplePixels(
         ctx.sampler, stats, view,

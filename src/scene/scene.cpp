@@ -166,8 +166,9 @@ Scene::Scene(SceneDesc desc) : m_desc(std::move(desc)) {
         if (moving)
             for (auto& s : m_desc.spheres) m_sphereMotion.push_back({s.velocity * shutter});
         if (m_geometry.size() <= id) m_geometry.resize(id + 1);
-        m_geometry[id] = {m_sphereMaterials.data(), nullptr, 0, object, true};
-        m_geometry[id].moves = moving;
+        GeometryInfo& g = m_geometry[id];
+        g = GeometryInfo{};
+        g.materialIds = m_sphereMaterials.data(), g.object = object, g.sphere = true, g.moves = moving;
         object += uint32_t(m_desc.spheres.size());
         for (auto& s : m_desc.spheres) m_objectMoves.push_back(s.velocity * shutter != Vec3f(0.f));
         for (auto& s : m_desc.spheres) m_objectHalfExtents.push_back(Vec3f(s.radius));
