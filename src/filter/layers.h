@@ -89,8 +89,8 @@
 // still layer, on the primary surface of a pixel that saw several, where the layer's slope is
 // at least 2 px, and wherever the slope is at least 8 px, where the filtered light would blur
 // twice (layers.cpp, radianceOf).
-// Emitted light is not reconstructed here but where a small emitter moves far (a light's
-// streak: LightFieldSamples::wideBlur): there a sample that sees it carries its emission with
+// Emitted light is not reconstructed here but where a moving light is spread thin over its blur
+// (a small light's streak: LightFieldSamples::wideBlur): there a sample that sees it carries its emission with
 // its own radiance (and no albedo, so that it keeps its own under the filters' light), and the
 // pixels within its reach take more rays (LayerOptions::emitterRays). The caller adds the rest
 // of each pixel's own emission (densely sampled at emitter edges).
