@@ -2052,7 +2052,8 @@ TEST(Layers, ASmallMovingEmittersStreakIsItsShutterAverage) {
     // its trajectory (render/sampling.h, LightFieldSamples::wideBlur) and no pixel is topped up
     // for it. Measured at seeds 1-8: the interior's columns within RMS 0.5-0.6% of their mean
     // (worst 1.8%); their mean, the light the samples found, 0.94-1.04 of the closed form, 0.993
-    // over the eight; nothing beyond; 0.15 of the rays of --layers off, which tops up the
+    // over the eight; nothing beyond; 0.15 of the rays of --layers off (with 256 path samples at
+    // emitter edges, before 2026-12-02; bound 0.3), which tops up the
     // pixels whose samples saw it.
     const char* json = R"({
       "camera": {"position": [0, 0, 0], "look_at": [0, 0, -1], "up": [0, 1, 0], "fov_y": 40, "resolution": [64, 64]},

@@ -1204,8 +1204,9 @@ TEST(Render, AFilterKeepsItsOwnImageAwayFromSilhouettes) {
 TEST(Render, AnEmittersEdgeTakesItsDenseEmissionAtAnySampleCountBelowItsRays) {
     // A lamp seen from below, MC without layers: a pixel on its edge takes its emitted light from
     // kEmitterEdgeRays camera rays (denseEmission), the same value at 16 samples a pixel (topped
-    // up to 256) and at 256, where before it kept its 256 samples' own (cornell at 256x256, 256
-    // spp: relMSE 0.000190 before, 0.000131 with them, against a 1024-spp render).
+    // up to kEmitterEdgeSpp) and at kEmitterEdgeSpp, where before it kept those samples' own
+    // (cornell at 256x256, 256 spp: relMSE 0.000190 before, 0.000131 with them, against a
+    // 1024-spp render).
     const scene::Scene s(parse(R"({
       "camera": {"position": [0, 0, 0], "look_at": [0, 1, 0], "up": [0, 0, 1], "fov_y": 40, "resolution": [24, 24]},
       "materials": {"grey": {"albedo": [0.5, 0.5, 0.5]}},
@@ -2001,7 +2002,7 @@ TEST(Render, EmitterRimsTakeTheirEmissionFromManyCameraRays) {
     for (int y = 0; y < 64; ++y)
         for (int x = 0; x < 64; ++x) {
             const size_t p = size_t(y) * 64 + x;
-            if (fb.spp[p] < 256) continue;  // not topped up
+            if (fb.spp[p] < render::kEmitterEdgeSpp) continue;  // not topped up
             ++rim;
             const Vec3f dense = sampler.meanEmission(x, y, render::kEmitterEdgeRays);
             EXPECT_EQ(fb.emission[p].x, dense.x);

@@ -36,11 +36,15 @@ void renderAaf(const MethodContext& ctx, RenderResult& result);
 void renderMaaf(const MethodContext& ctx, RenderResult& result);
 void renderAtrous(const MethodContext& ctx, RenderResult& result);
 
-/// Samples per pixel at emitter edges (PixelStats::emitterTopUp), for every method. Measured on
-/// cornell 512x512 (its ceiling light's edge dominates every filter's error), relMSE with 64 /
-/// 256 / 1024: aaf 0.000225 / 0.000191 / 0.000184 at 22.5 / 23.0 / 24.8 spp on average, atrous
-/// 0.000357 / 0.000322 / 0.000315 at 16.1 / 16.6 / 18.4; 256 is the most efficient.
-constexpr uint32_t kEmitterEdgeSpp = 256;
+/// Samples per pixel at emitter edges (PixelStats::emitterTopUp), for every method. Their emitted
+/// light comes from denseEmission's kEmitterEdgeRays camera rays; these path samples are for the
+/// rest of the pixel (the surfaces beside the emitter and their light). 256 was measured before
+/// the dense emission (cornell 512x512, aaf relMSE 0.000225 / 0.000191 / 0.000184 at 64 / 256 /
+/// 1024); with it, 64 measured the same relMSE (-1% to +2%: cornell, conference, sponza,
+/// cornell-sphere, docs/bokeh.json, docs/lights.json; MC and AAF, seeds 3 and 4) in 0.54-0.73x the
+/// time on the two held-out views of small lights out of focus (1.4-1.8x the efficiency) and
+/// 0.90-0.94x on cornell (docs/layers.md, "Fewer path samples at emitter edges").
+constexpr uint32_t kEmitterEdgeSpp = 64;
 
 /// Extra samples at the edges of visible emitters, for every method: up to `target` samples for
 /// each pixel whose samples partly saw an emitter (PixelStats::emitterTopUp) and for each pixel
