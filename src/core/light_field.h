@@ -255,8 +255,10 @@ public:
         const float c = std::abs(m_lensPixels * (inverseDepth - m_inverseFocus));
         return 4.f * e.x * e.y <= kWideCoverage * (2.f * (along + c) + m) * (2.f * (across + c));
     }
-    /// Per pixel, the emission its own samples saw (luminance, summed) and the part of it that
-    /// wide samples carry into the layers: the pixel keeps the rest of its emission
+    /// What addEmission and setEmission count of an emitted radiance: its channels' mean.
+    static float emissionLevel(const Vec3f& e) { return (e.x + e.y + e.z) / 3.f; }
+    /// Per pixel, the emission its own samples saw (emissionLevel, summed) and the part of it
+    /// that wide samples carry into the layers: the pixel keeps the rest of its emission
     /// (ownEmissionShare, 1 where its samples saw none).
     void addEmission(size_t p, float luminance, bool wide) {
         m_emission[p] += luminance;

@@ -56,7 +56,8 @@ constexpr uint32_t kEmitterEdgeSpp = 64;
 /// wideBlur: a moving light spread thin over its blur).
 Image<uint32_t> emitterTopUps(const PixelStatsImage& stats, uint32_t target, const LightFieldSamples* lf = nullptr);
 /// Gives every rank the per-pixel emission sums of the others' rows (LightFieldSamples::
-/// emissionData, wideEmissionData), which emitterTopUps reads across them; nothing without `lf`.
+/// emissionData, wideEmissionData), which emitterTopUps reads across them (and, called at the end
+/// of denseEmission, the layers' composition); nothing without `lf`.
 void shareEmissions(LightFieldSamples* lf, const Distribution* distribution);
 
 /// The light-field stage of aaf's and maaf's adaptive samples (`extra` per pixel): a pixel's are

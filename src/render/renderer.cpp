@@ -225,7 +225,7 @@ uint64_t denseEmission(const MethodContext& ctx, const Image<uint32_t>& topUp, F
             // emitter is topped up too.)
             Vec3f wide(0.f);
             const Vec3f e = ctx.sampler.meanEmission(x, y, kEmitterEdgeRays, ctx.lightField, ctx.lightField ? &wide : nullptr);
-            if (ctx.lightField) ctx.lightField->setEmission(p, (e.x + e.y + e.z) / 3.f, (wide.x + wide.y + wide.z) / 3.f);
+            if (ctx.lightField) ctx.lightField->setEmission(p, LightFieldSamples::emissionLevel(e), LightFieldSamples::emissionLevel(wide));
             fb.color[p] += e - fb.emission[p];
             fb.emission[p] = e;
             local += kEmitterEdgeRays;
@@ -234,10 +234,7 @@ uint64_t denseEmission(const MethodContext& ctx, const Image<uint32_t>& topUp, F
     });
     exchangeImageRows(ctx.sampler.distribution(), fb.color.data(), fb.width, fb.height);
     exchangeImageRows(ctx.sampler.distribution(), fb.emission.data(), fb.width, fb.height);
-    if (ctx.lightField) {
-        exchangeImageRows(ctx.sampler.distribution(), ctx.lightField->emissionData(), fb.width, fb.height);
-        exchangeImageRows(ctx.sampler.distribution(), ctx.lightField->wideEmissionData(), fb.width, fb.height);
-    }
+    shareEmissions(ctx.lightField, ctx.sampler.distribution());
     return rays;
 }
 
@@ -360,10 +357,9 @@ Image3f visibilityImage(const FrameBuffers& fb) {
 void finishLightField(const MethodContext& ctx, const PixelStatsImage& stats) {
     if (!ctx.lightField) return;
     LightFieldSamples& lf = *ctx.lightField;
-    exchangeLightField(ctx.sampler.distribution(), lf);  // each rank recorded its own rows' samples
-    // ... and their emissions (LightFieldSamples::ownEmissionShare).
-    exchangeImageRows(ctx.sampler.distribution(), lf.emissionData(), lf.width(), lf.height());
-    exchangeImageRows(ctx.sampler.distribution(), lf.wideEmissionData(), lf.width(), lf.height());
+    // Each rank recorded its own rows' samples. (Their per-pixel emissions are exchanged by
+    // denseEmission, which every method calls next and which replaces some of them first.)
+    exchangeLightField(ctx.sampler.distribution(), lf);
     parallelRows(lf.height(), [&](int y) {
         for (int x = 0; x < lf.width(); ++x) {
             const size_t p = size_t(y) * lf.width() + x;

@@ -41,7 +41,7 @@ public:
         // albedo: its radiance is then its own everywhere, where the filters' light (albedo x
         // the surface's filtered light) would drop the emission (LightFieldSamples::wideBlur).
         // Its pixel's emission counts it, kept or not, as the pixel's statistics do.
-        const float emitted = (s.emission.x + s.emission.y + s.emission.z) / 3.f;
+        const float emitted = LightFieldSamples::emissionLevel(s.emission);
         const bool wide = emitted > 0.f && m_lf->wideBlur(s.depth, s.motion, s.object);
         if (emitted > 0.f) m_lf->addEmission(p, emitted, wide);
         if (m_fill[p] == m_lf->runLength(m_stage, p)) return;
