@@ -1,6 +1,7 @@
 #!/usr/bin/env python3
 """Checks that the loops whose speed rests on the compiler vectorising them still are vectorised
-in a Release binary: the layered reconstruction's rays (filter/layers.cpp, traceBlurredRays) and
+in a Release binary: the layered reconstruction's rays (filter/layers.cpp, traceBlurredRays, and a
+moving layer's window, traceWindowed) and
 the sampler's camera rays, light samples and bounce directions (render/camera.cpp,
 render/path_sampler.cpp). A change that turns one of them scalar keeps every image and test as
 it was and only costs time, which no test asserts: this looks at the code instead.
@@ -22,6 +23,9 @@ CHECKS = [
     # (Not the two instances along a large turn's arcs, kArc: GCC does not vectorise them, a
     # known lead in filter/layers.cpp; they run only where a layer turns that far.)
     ("the layered reconstruction's rays", r"traceBlurredRays<[^>]*, false>", 8, PACKED),
+    # A moving layer's window (traceWindowed, inlined where traceBlurred calls it): which rays
+    # can read a covered cell, the only loop of its own there.
+    ("a moving layer's window", r"traceBlurred<(true|false), true, false>\(", 2, PACKED),
     ("the camera rays of a batch", r"Camera::generate\(int,", 1, PACKED),
     ("the light samples of a batch", r"samplePlanarLights\(", 1, PACKED),
     # traceMany's own arithmetic is scalar but for the bounce directions' loop (bounceDirections,

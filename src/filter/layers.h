@@ -69,7 +69,8 @@
 //    that motion too), shaped so that the grid's own blur (cells,
 //    Gaussian, bilinear lookup) over the rays' disc (segment) gives the true disc's (segment's)
 //    edge profile as nearly as a near-Gaussian allows (rays drawn towards the rim: layers.cpp,
-//    Shaped): C += T alpha L, T *= 1 - alpha.
+//    Shaped): C += T alpha L, T *= 1 - alpha. (A moving layer is traced only for the rays
+//    whose lookups can land on a cell it covers: layers.cpp, traceWindowed.)
 //    Light the layers leave uncovered (a hole no sample saw) is the mean of what they cover.
 //    Where every layer of the tile is sharp, one ray at the pixel gives the same: the pixel's
 //    own samples composited by surface, as without layers. A pixel whose 32 rays straddle
@@ -185,8 +186,11 @@ struct LayerOptions {
     // Smooth and resolve every cell of each layer's grids, also beyond the cells its
     // accumulations can reach (the stage works within those, CellBox in layers.cpp), and trace a
     // pixel's rays through every layer within its reach as one radius (the stage skips those
-    // its rays cannot read along each axis apart, Layer::rayExtent). For the test that neither
-    // changes an image, layers_test Layers.TheCellsBeyondALayersAccumulationsChangeNoImage.
+    // its rays cannot read along each axis apart, Layer::rayExtent), and every one of those rays
+    // through a moving layer (the stage traces only those that can read a covered cell of it,
+    // traceWindowed). For the test that none of these changes an image, layers_test
+    // Layers.TheCellsBeyondALayersAccumulationsChangeNoImage and
+    // Layers.RaysOutsideAMovingLayersWindowFindNothingThere.
     bool everyCell = false;
     // A blurred moving layer whose samples move along one axis of the grid, in focus (slopes
     // within 0.75 px), keeps the other axis crisp: the rays' lookup there the nearest cell, the
