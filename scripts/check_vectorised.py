@@ -23,9 +23,8 @@ CHECKS = [
     # (Not the two instances along a large turn's arcs, kArc: GCC does not vectorise them, a
     # known lead in filter/layers.cpp; they run only where a layer turns that far.)
     ("the layered reconstruction's rays", r"traceBlurredRays<[^>]*, false>", 8, PACKED),
-    # A moving layer's window (traceWindowed, inlined where traceBlurred calls it): which rays
-    # can read a covered cell, the only loop of its own there.
-    ("a moving layer's window", r"traceBlurred<(true|false), true, false>\(", 2, PACKED),
+    # A moving layer's window: which rays can read a covered cell.
+    ("a moving layer's window", r"traceWindowed<(true|false), (true|false)>\(", 4, PACKED),
     ("the camera rays of a batch", r"Camera::generate\(int,", 1, PACKED),
     ("the light samples of a batch", r"samplePlanarLights\(", 1, PACKED),
     # traceMany's own arithmetic is scalar but for the bounce directions' loop (bounceDirections,

@@ -554,32 +554,38 @@ struct Layer {
     /// (motionExtent, sagExtent).
     Vec2f rayExtent{};
     Vec2f motionExtent{}, sagExtent{};  // the largest |x| and |y| over motionGrid, sagGrid
-    // A moving layer's window (traceWindowed): the largest lens shear a ray can take (|A + B
-    // |u|^2| over the rays' shear and its slope table), and per block of kMotionBlock x
-    // kMotionBlock cells of motionGrid the least and largest motion a bilinear or nearest-cell
-    // lookup in it can read (x lo, x hi, y lo, y hi).
-    float lensReach = 0;
-    static constexpr int kMotionBlock = 8;
+    // A moving layer's window (traceWindowed): the least and largest lens shear A + B |u|^2 its
+    // rays can take where they follow the slope they find (over its slope table), and per block
+    // of kWindowBlock x kWindowBlock cells of motionGrid the least and largest motion a ray whose
+    // first lookup lands in the block can read (bilinear, or a crisp axis's nearest cell: two
+    // cells beyond the block each way): x lo, x hi, y lo, y hi.
+    float shearLo = 0, shearHi = 0;
+    static constexpr int kWindowBlock = 8;
     int blocksX = 0, blocksY = 0;
-    std::vector<float> motionBlocks;
-    void buildMotionBlocks() {
-        blocksX = (gw + kMotionBlock - 1) / kMotionBlock, blocksY = (gh + kMotionBlock - 1) / kMotionBlock;
-        motionBlocks.assign(size_t(blocksX) * blocksY * 4, 0.f);
+    std::vector<float> windowBlocks;
+    void buildWindow() {
+        shearLo = shearHi = 0;
+        if (followsSlope()) {
+            shearLo = kInf, shearHi = -kInf;
+            for (const Shaped& k : shearTable) shearLo = std::min({shearLo, k.a, k.a + k.b}), shearHi = std::max({shearHi, k.a, k.a + k.b});
+        }
+        windowBlocks.clear();
+        blocksX = blocksY = 0;
+        if (motionGrid.empty()) return;
+        blocksX = (gw + kWindowBlock - 1) / kWindowBlock, blocksY = (gh + kWindowBlock - 1) / kWindowBlock;
+        windowBlocks.assign(size_t(blocksX) * blocksY * 4, 0.f);
         for (int by = 0; by < blocksY; ++by)
             for (int bx = 0; bx < blocksX; ++bx) {
-                // (Two cells beyond the block each way: a lookup whose first cell is in the block
-                // reads the next one too, and the nearest-cell lookup of a crisp axis lies half a
-                // cell from the bilinear one.)
-                const int i0 = std::max(0, bx * kMotionBlock - 2), i1 = std::min(gw, (bx + 1) * kMotionBlock + 2);
-                const int j0 = std::max(0, by * kMotionBlock - 2), j1 = std::min(gh, (by + 1) * kMotionBlock + 2);
+                const int i0 = std::max(0, bx * kWindowBlock - 2), i1 = std::min(gw, (bx + 1) * kWindowBlock + 2);
+                const int j0 = std::max(0, by * kWindowBlock - 2), j1 = std::min(gh, (by + 1) * kWindowBlock + 2);
                 Vec2f lo{kInf, kInf}, hi{-kInf, -kInf};
                 for (int j = j0; j < j1; ++j)
                     for (int i = i0; i < i1; ++i) {
                         const float* m = &motionGrid[2 * (size_t(j) * gw + size_t(i))];
                         lo = vmin(lo, Vec2f{m[0], m[1]}), hi = vmax(hi, Vec2f{m[0], m[1]});
                     }
-                float* b = &motionBlocks[4 * (size_t(by) * blocksX + size_t(bx))];
-                b[0] = lo.x, b[1] = hi.x, b[2] = lo.y, b[3] = hi.y;
+                float* w = &windowBlocks[4 * (size_t(by) * blocksX + size_t(bx))];
+                w[0] = lo.x, w[1] = hi.x, w[2] = lo.y, w[3] = hi.y;
             }
     }
     int accStride() const { return 2 + 4 * timeBins; }
@@ -1454,6 +1460,8 @@ struct Bilinear {
 [[gnu::always_inline]] inline float clampValue(float v, float lo, float hi) { return v < lo ? lo : hi < v ? hi : v; }
 [[gnu::always_inline]] inline int minValue(int a, int b) { return b < a ? b : a; }
 [[gnu::always_inline]] inline int maxValue(int a, int b) { return a < b ? b : a; }
+[[gnu::always_inline]] inline float minFloat(float a, float b) { return b < a ? b : a; }
+[[gnu::always_inline]] inline float maxFloat(float a, float b) { return a < b ? b : a; }
 [[gnu::always_inline]] inline Bilinear bilinear(const Layer& l, Vec2f p) {
     // (Both roundings computed and one selected: a floor under the condition is a masked call,
     // which kept traceBlurred's loops from vectorising.)
@@ -1856,28 +1864,30 @@ void traceBlurredRays(const Layer& l, const Rays& ray, int j0, int j1, const Ble
 /// a moving layer was traced for found nothing there, on bunny-slats, crossing and many-motion
 /// 55-82% (docs/layers.md, "A moving layer's rays where they can find it"). Per ray, a bound of
 /// where its final lookup lands: its film point; its lens point times its own lens shear, or
-/// (kFollow) the largest its layer's slopes give (Layer::lensReach); less its motion shift m s
-/// at its time, s its offset along the chord as traceBlurredRays computes it and m between
-/// the least and largest motion of the grid's block where its first lookup lands
-/// (Layer::motionBlocks; a layer without a grid: its rays' own shift); two cells to spare.
+/// (kFollow) any its layer's slope table gives (Layer::shearLo, shearHi); less its motion
+/// shift m s at its time, s its offset along the chord as traceBlurredRays computes it and m
+/// within the motion of the grid's block where its first lookup lands (Layer::windowBlocks; a
+/// layer without a grid: its rays' own shift); two cells to spare.
 /// Where no cell within that bound is covered (Layer::covered) the ray is left out. The others
 /// are copied into a scratch set and traced by the same loop: the same alpha and light per ray,
 /// the same image to the byte. Returns false (nothing done) where three quarters of the rays
 /// or more pass: the plain loop is cheaper there.
 /// (Not for a turning layer's arcs: their sagitta moves the lookup too.)
+// (Not inlined: scripts/check_vectorised.py finds its loop by its name.)
 template <bool kFollow, bool kGrid>
-bool traceWindowed(const Layer& l, const Rays& ray, int j0, int j1, const Blend& own, Taken& taken) {
+[[gnu::noinline]] bool traceWindowed(const Layer& l, const Rays& ray, int j0, int j1, const Blend& own, Taken& taken) {
     const int n = j1 - j0;
     if (n < 8) return false;
     alignas(64) static thread_local int in[Rays::kLength];
     const float depthRate = l.depthRate, rayT2 = l.rayT2, middle = chordMiddle(depthRate);
-    const float lens = l.lensReach, rayC = l.rayC, rayC2 = l.rayC2, rayMx = l.rayMx, rayMy = l.rayMy;
+    const float rayC = l.rayC, rayC2 = l.rayC2, rayMx = l.rayMx, rayMy = l.rayMy, shearLo = l.shearLo, shearHi = l.shearHi;
     const float middleX = l.mx * middle, middleY = l.my * middle, scale = l.motionScale;
     const AffineMotion f = l.motionFit;
     const float fromX = f.mean.x - (f.b00 * f.centre.x + f.b01 * f.centre.y), fromY = f.mean.y - (f.b10 * f.centre.x + f.b11 * f.centre.y);
     const float invStep = l.invStep, gx0 = float(l.gx0), gy0 = float(l.gy0), lastX = float(l.gw - 1), lastY = float(l.gh - 1);
-    const int gw = l.gw, blocksX = l.blocksX, blocksY = l.blocksY;
-    const float* blocks = l.motionBlocks.data();
+    const int gw = l.gw, blocksX = std::max(l.blocksX, 1), blocksY = std::max(l.blocksY, 1);
+    static const float kNoBlock[4] = {0.f, 0.f, 0.f, 0.f};  // (read, and not used, without a grid)
+    const float* blocks = kGrid ? l.windowBlocks.data() : kNoBlock;
     const int* sat = l.covered.data();
     int count = 0;
 #pragma omp simd reduction(+ : count)
@@ -1885,35 +1895,37 @@ bool traceWindowed(const Layer& l, const Rays& ray, int j0, int j1, const Blend&
         const float along = alongChord(ray.dt[j], depthRate) - middle;
         const float shaped = along * (1.f + rayT2 * 4.f * along * along);
         const float cRay = rayC + rayC2 * ray.u2[j];
-        // The ray's lens shear: its own, or (kFollow) any the layer's slopes give.
-        const float cx = kFollow ? ray.px[j] : ray.px[j] + cRay * ray.ux[j], cy = kFollow ? ray.py[j] : ray.py[j] - cRay * ray.uy[j];
-        const float wx = kFollow ? lens * std::abs(ray.ux[j]) : 0.f, wy = kFollow ? lens * std::abs(ray.uy[j]) : 0.f;
-        float sx0, sx1, sy0, sy1;  // the motion shift of the final lookup, m s: its range
-        if constexpr (kGrid) {
-            // The first lookup, p = q - s m_fit(p) (motionShift; where the fit folds, the mean
-            // motion's shift), and the motion the grid can give there (its block's range).
-            const float sigma = scale * shaped + middle;
-            const float qx = ray.px[j] + cRay * ray.ux[j], qy = ray.py[j] - cRay * ray.uy[j];
-            const float a00 = 1.f + sigma * f.b00, a01 = sigma * f.b01, a10 = sigma * f.b10, a11 = 1.f + sigma * f.b11;
-            const float rx = qx - sigma * fromX, ry = qy - sigma * fromY, det = a00 * a11 - a01 * a10;
-            const bool solvable = det > 0.2f;
-            const float pX = solvable ? (a11 * rx - a01 * ry) / det : qx - (rayMx * shaped + middleX);
-            const float pY = solvable ? (a00 * ry - a10 * rx) / det : qy - (rayMy * shaped + middleY);
-            const int bx = minValue(int(clampValue(pX * invStep - gx0 - 0.5f, 0.f, lastX)) / Layer::kMotionBlock, blocksX - 1);
-            const int by = minValue(int(clampValue(pY * invStep - gy0 - 0.5f, 0.f, lastY)) / Layer::kMotionBlock, blocksY - 1);
-            const int bi = 4 * (by * blocksX + bx);
-            const float lox = blocks[bi] * sigma, hix = blocks[bi + 1] * sigma, loy = blocks[bi + 2] * sigma, hiy = blocks[bi + 3] * sigma;
-            sx0 = minValue(lox, hix), sx1 = maxValue(lox, hix), sy0 = minValue(loy, hiy), sy1 = maxValue(loy, hiy);
-        } else {
-            sx0 = sx1 = rayMx * shaped + middleX;
-            sy0 = sy1 = rayMy * shaped + middleY;
-        }
+        const float qx = ray.px[j] + cRay * ray.ux[j], qy = ray.py[j] - cRay * ray.uy[j];
+        // The first lookup: p = q - s m_fit(p) (motionShift; where the fit folds, and on a
+        // layer without a grid, the rays' own shift). (Written as one expression each, as in
+        // traceBlurredRays: values assigned in branches kept the loop scalar.)
+        const float ownX = rayMx * shaped + middleX, ownY = rayMy * shaped + middleY;
+        const float sigma = scale * shaped + middle;
+        const float a00 = 1.f + sigma * f.b00, a01 = sigma * f.b01, a10 = sigma * f.b10, a11 = 1.f + sigma * f.b11;
+        const float rx = qx - sigma * fromX, ry = qy - sigma * fromY, det = a00 * a11 - a01 * a10;
+        const bool solvable = kGrid && det > 0.2f;
+        const float pX = solvable ? (a11 * rx - a01 * ry) / det : qx - ownX, pY = solvable ? (a00 * ry - a10 * rx) / det : qy - ownY;
+        // The final lookup's lens shear: the ray's own, or (kFollow) within the slope table's
+        // range (its x term c u_x, its y term -c u_y).
+        const float cLo = kFollow ? shearLo : cRay, cHi = kFollow ? shearHi : cRay;
+        const float ux = ray.ux[j], uy = ray.uy[j];
+        const float lx0 = minFloat(cLo * ux, cHi * ux), lx1 = maxFloat(cLo * ux, cHi * ux);
+        const float ly0 = minFloat(-cLo * uy, -cHi * uy), ly1 = maxFloat(-cLo * uy, -cHi * uy);
+        // ... and its motion shift, m s: m within the range of the grid's block where the first
+        // lookup lands (without a grid, the rays' own shift).
+        const int bx = minValue(int(clampValue(pX * invStep - gx0 - 0.5f, 0.f, lastX)) / Layer::kWindowBlock, blocksX - 1);
+        const int by = minValue(int(clampValue(pY * invStep - gy0 - 0.5f, 0.f, lastY)) / Layer::kWindowBlock, blocksY - 1);
+        const int bi = kGrid ? 4 * (by * blocksX + bx) : 0;
+        const float lox = blocks[bi] * sigma, hix = blocks[bi + 1] * sigma, loy = blocks[bi + 2] * sigma, hiy = blocks[bi + 3] * sigma;
+        const float sx0 = kGrid ? minFloat(lox, hix) : ownX, sx1 = kGrid ? maxFloat(lox, hix) : ownX;
+        const float sy0 = kGrid ? minFloat(loy, hiy) : ownY, sy1 = kGrid ? maxFloat(loy, hiy) : ownY;
+        const float cx0 = ray.px[j] + lx0, cx1 = ray.px[j] + lx1, cy0 = ray.py[j] + ly0, cy1 = ray.py[j] + ly1;
         // The cells the final lookup can read (two more each way: rounding, a crisp axis's
         // nearest cell), clamped to the grid as the lookup is, and whether one is covered.
-        const int i0 = int(clampValue((cx - wx - sx1) * invStep - gx0 - 2.f, 0.f, lastX));
-        const int i1 = int(clampValue((cx + wx - sx0) * invStep - gx0 + 2.f, 0.f, lastX));
-        const int k0 = int(clampValue((cy - wy - sy1) * invStep - gy0 - 2.f, 0.f, lastY));
-        const int k1 = int(clampValue((cy + wy - sy0) * invStep - gy0 + 2.f, 0.f, lastY));
+        const int i0 = int(clampValue((cx0 - sx1) * invStep - gx0 - 2.f, 0.f, lastX));
+        const int i1 = int(clampValue((cx1 - sx0) * invStep - gx0 + 2.f, 0.f, lastX));
+        const int k0 = int(clampValue((cy0 - sy1) * invStep - gy0 - 2.f, 0.f, lastY));
+        const int k1 = int(clampValue((cy1 - sy0) * invStep - gy0 + 2.f, 0.f, lastY));
         const int s = gw + 1;
         const bool reads = sat[(k1 + 1) * s + i1 + 1] - sat[k0 * s + i1 + 1] - sat[(k1 + 1) * s + i0] + sat[k0 * s + i0] > 0;
         in[j] = reads ? 1 : 0;
@@ -3043,7 +3055,6 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                             l.motionExtent = vmax(l.motionExtent, Vec2f{std::abs(mx), std::abs(my)});
                         }
                         l.maxMotion = std::sqrt(reach);
-                        l.buildMotionBlocks();
                         l.motionSpread = std::sqrt(spread);
                         l.sagGrid.clear();
                         l.maxSag = 0;
@@ -3214,9 +3225,7 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                     }
                     l.buildCovered();
                     const float slopeReach = std::max({std::abs(l.cMin), std::abs(l.cMax), std::abs(l.rayC), std::abs(l.rayC + l.rayC2)});
-                    l.lensReach = std::max(std::abs(l.rayC), std::abs(l.rayC + l.rayC2));
-                    if (l.followsSlope())
-                        for (const Shaped& k : l.shearTable) l.lensReach = std::max({l.lensReach, std::abs(k.a), std::abs(k.a + k.b)});
+                    if (l.moving) l.buildWindow();
                     const float chord = chordReach(l.depthRate);
                     // (The rays' segment is shaped about the chord's middle, which lies off the
                     // mid-shutter point where the depth changes: where motionScale < 1 its ends
