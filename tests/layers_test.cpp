@@ -394,6 +394,11 @@ TEST(Layers, RaysOutsideAMovingLayersWindowFindNothingThere) {
     few.maxLayers = 4;
     everyCell.maxLayers = 4;
     expectTheSameBits(lf, view, few, everyCell);
+    // The D pass of a moving layer reads, per row, only the pixels whose samples its trail's
+    // band can count; the image must be the one that counts every D.
+    filter::LayerOptions countEveryD;
+    countEveryD.countEveryD = true;
+    expectTheSameBits(lf, view, filter::LayerOptions{}, countEveryD);
 }
 
 TEST(Layers, WhereAFilteredLightIsAnotherPointsASampleCarriesItsOwn) {

@@ -2957,10 +2957,15 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                 std::vector<float>& farthest = local.farthest;  // per layer: its farthest sample's inverse depth
                 farthest.resize(size_t(nLayers));
                 for (int k = 0; k < nLayers; ++k) farthest[size_t(k)] = layers[size_t(k)].invDepthMin;
-                auto forEachBehind = [&](int k, int wx0, int wx1, int wy0, int wy1, auto&& fn) {
+                // (`band(y, x0, x1)` may narrow row y's pixels [x0, x1) to those whose samples
+                // can count.)
+                auto forEachBehindIn = [&](int k, int wx0, int wx1, int wy0, int wy1, auto&& band, auto&& fn) {
                     for (int y = wy0; y < wy1 && wx0 < wx1; ++y) {
-                        const uint32_t i0 = pixelStart[size_t(y - ry0) * rw + (wx0 - rx0)];
-                        const uint32_t i1 = pixelStart[size_t(y - ry0) * rw + (wx1 - rx0)];
+                        int x0 = wx0, x1 = wx1;
+                        band(y, x0, x1);
+                        if (x0 >= x1) continue;
+                        const uint32_t i0 = pixelStart[size_t(y - ry0) * rw + (x0 - rx0)];
+                        const uint32_t i1 = pixelStart[size_t(y - ry0) * rw + (x1 - rx0)];
                         for (uint32_t i = i0; i < i1; ++i) {
                             const int sl = sampleLayer[i];
                             const Gathered& s = g[i];
@@ -2968,6 +2973,9 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                             fn(s, sl);
                         }
                     }
+                };
+                auto forEachBehind = [&](int k, int wx0, int wx1, int wy0, int wy1, auto&& fn) {
+                    forEachBehindIn(k, wx0, wx1, wy0, wy1, [](int, int&, int&) {}, fn);
                 };
                 std::vector<int>& occupiedStill = local.occupiedStill;
                 std::vector<uint8_t>& near = local.near;
@@ -3152,7 +3160,32 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                         const std::array<float, 4>& own = ownBox[size_t(k)];
                         const Vec2f mean = l.motionFit.mean;
                         const float spread = l.motionSpread, nearest = l.invDepthMax;
-                        forEachBehind(k, wx0, wx1, wy0, wy1, [&](const Gathered& s, int sl) {
+                        // Per row, the pixels whose samples can pass that test: their q within
+                        // |c| of the pixel, their dt between the chord's ends (alongChord is
+                        // monotone for |depthRate| < 2), r at most its value at the larger end;
+                        // the dts row y's q can take, then the q along x those dts allow. A
+                        // diagonal trail's samples lie in a band of its reach box (docs/snow.json:
+                        // this pass read every sample of the box for every moving layer).
+                        const float dtA = alongChord(-0.5f, l.depthRate), dtB = alongChord(0.5f, l.depthRate);
+                        const float rMax = std::max(std::abs(dtA), std::abs(dtB)) * spread + l.maxSag + 2.f, cAbs = std::abs(l.c);
+                        const bool banded = !countEveryD && std::abs(l.depthRate) < 1.9f;
+                        auto band = [&](int y, int& x0, int& x1) {
+                            if (!banded) return;
+                            // dt my within [lo, hi] for some q_y of the row (a pixel to spare).
+                            const float lo = float(y) - cAbs - own[3] - rMax - 1.f, hi = float(y) + 2.f + cAbs - own[1] + rMax;
+                            float d0 = dtA, d1 = dtB;
+                            if (mean.y > 1e-6f) d0 = std::max(d0, lo / mean.y), d1 = std::min(d1, hi / mean.y);
+                            else if (mean.y < -1e-6f) d0 = std::max(d0, hi / mean.y), d1 = std::min(d1, lo / mean.y);
+                            else if (lo > 0.f || hi < 0.f) d1 = d0 - 1.f;
+                            if (d0 > d1) {
+                                x1 = x0;
+                                return;
+                            }
+                            const float m0 = std::min(d0 * mean.x, d1 * mean.x), m1 = std::max(d0 * mean.x, d1 * mean.x);
+                            x0 = std::max(x0, int(std::floor(own[0] - rMax + m0 - cAbs)) - 1);
+                            x1 = std::min(x1, int(std::ceil(own[2] + rMax + m1 + cAbs)) + 1);
+                        };
+                        forEachBehindIn(k, wx0, wx1, wy0, wy1, band, [&](const Gathered& s, int sl) {
                             const float qx = s.x + l.c * s.u, qy = s.y - l.c * s.v;
                             if (qx < box[0] || qy < box[1] || qx >= box[2] || qy >= box[3]) return;
                             if (!countEveryD) {
