@@ -1883,7 +1883,6 @@ template <bool kFollow, bool kGrid>
     const float rayC = l.rayC, rayC2 = l.rayC2, rayMx = l.rayMx, rayMy = l.rayMy, shearLo = l.shearLo, shearHi = l.shearHi;
     const float middleX = l.mx * middle, middleY = l.my * middle, scale = l.motionScale;
     const AffineMotion f = l.motionFit;
-    const float fromX = f.mean.x - (f.b00 * f.centre.x + f.b01 * f.centre.y), fromY = f.mean.y - (f.b10 * f.centre.x + f.b11 * f.centre.y);
     const float invStep = l.invStep, gx0 = float(l.gx0), gy0 = float(l.gy0), lastX = float(l.gw - 1), lastY = float(l.gh - 1);
     const int gw = l.gw, blocksX = std::max(l.blocksX, 1), blocksY = std::max(l.blocksY, 1);
     static const float kNoBlock[4] = {0.f, 0.f, 0.f, 0.f};  // (read, and not used, without a grid)
@@ -1896,15 +1895,13 @@ template <bool kFollow, bool kGrid>
         const float shaped = along * (1.f + rayT2 * 4.f * along * along);
         const float cRay = rayC + rayC2 * ray.u2[j];
         const float qx = ray.px[j] + cRay * ray.ux[j], qy = ray.py[j] - cRay * ray.uy[j];
-        // The first lookup: p = q - s m_fit(p) (motionShift; where the fit folds, and on a
-        // layer without a grid, the rays' own shift). (Written as one expression each, as in
-        // traceBlurredRays: values assigned in branches kept the loop scalar.)
+        // The first lookup, q less its shift: on a grid, motionShift's (as traceBlurredRays
+        // takes it); without one, and where the fit folds, the rays' own. (One expression each,
+        // as in traceBlurredRays: values assigned in branches kept the loop scalar.)
         const float ownX = rayMx * shaped + middleX, ownY = rayMy * shaped + middleY;
         const float sigma = scale * shaped + middle;
-        const float a00 = 1.f + sigma * f.b00, a01 = sigma * f.b01, a10 = sigma * f.b10, a11 = 1.f + sigma * f.b11;
-        const float rx = qx - sigma * fromX, ry = qy - sigma * fromY, det = a00 * a11 - a01 * a10;
-        const bool solvable = kGrid && det > 0.2f;
-        const float pX = solvable ? (a11 * rx - a01 * ry) / det : qx - ownX, pY = solvable ? (a00 * ry - a10 * rx) / det : qy - ownY;
+        const Vec2f shift = kGrid ? motionShift(f, qx, qy, sigma, {ownX, ownY}) : Vec2f{ownX, ownY};
+        const float pX = qx - shift.x, pY = qy - shift.y;
         // The final lookup's lens shear: the ray's own, or (kFollow) within the slope table's
         // range (its x term c u_x, its y term -c u_y).
         const float cLo = kFollow ? shearLo : cRay, cHi = kFollow ? shearHi : cRay;
@@ -3258,7 +3255,7 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                     }
                     l.buildCovered();
                     const float slopeReach = std::max({std::abs(l.cMin), std::abs(l.cMax), std::abs(l.rayC), std::abs(l.rayC + l.rayC2)});
-                    if (l.moving) l.buildWindow();
+                    if (l.moving && !l.sharp) l.buildWindow();  // (a sharp layer's rays read its pixel's cell)
                     const float chord = chordReach(l.depthRate);
                     // (The rays' segment is shaped about the chord's middle, which lies off the
                     // mid-shutter point where the depth changes: where motionScale < 1 its ends
