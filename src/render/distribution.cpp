@@ -63,6 +63,12 @@ void exchangeLightField(const Distribution* d, LightFieldSamples& lf) {
                 LightFieldSag* end = lf.sagRun(stage, size_t(y + 1) * W);
                 return std::pair<char*, size_t>{reinterpret_cast<char*>(begin), size_t(end - begin) * sizeof(LightFieldSag)};
             });
+    // Which pixels' paths bend (LightFieldSamples::bentReach, marked as the samples are
+    // recorded): the layered reconstruction reads it for every sample a tile gathers, from any
+    // rank's rows. (Only aaf and maaf exchanged it, in bentPixels, before their adaptive
+    // samples: mc and à-trous on two ranks gave docs/turning-room.json another image than one
+    // process, in the tiles around its turning box.)
+    exchangeImageRows(d, lf.bentReachData(), lf.width(), lf.height());
 }
 
 std::vector<uint64_t> gatherCounts(const Distribution* d, uint64_t mine) {

@@ -82,7 +82,7 @@ void exchangeImageRows(const Distribution* d, T* data, int width, int height, si
 
 /// Every pixel's statistics (their further slots included) from the rank that owns its row.
 void exchangeStats(const Distribution* d, PixelStatsImage& stats);
-/// Every pixel's light-field samples, all stages, from the rank that owns its row.
+/// Every pixel's light-field samples, all stages, and its bentReach, from the rank that owns its row.
 void exchangeLightField(const Distribution* d, LightFieldSamples& lf);
 /// Every rank's `mine`, in rank order ({mine} without a distribution).
 std::vector<uint64_t> gatherCounts(const Distribution* d, uint64_t mine);
