@@ -579,13 +579,15 @@ TEST(Cli, ARenderTooLargeForTheMemoryLimitIsRefusedBeforeItStarts) {
 
 TEST(Cli, ARenderKeepingItsSamplesForTheLayersCountsThem) {
     // With a lens the layers keep every sample (24 bytes, and 12 a pixel beside them) until they
-    // reconstruct: 8x8 pixels at 64 spp add 96.75 KiB to the 75 KiB of the render's buffers;
-    // without a lens nothing is kept.
+    // reconstruct: 8x8 pixels at 64 spp add 96.75 KiB to the 75 KiB of the render's buffers, and
+    // the one thread the samples a tile gathers (all of them here, 66 bytes each, and 4 a pixel
+    // beside them: 264.25 KiB); without a lens nothing is kept.
     std::string dir = tempDir(), err;
     writeFile(dir + "/lens.json", scene(kSphere, "\"fov_y\": 40", "\"fov_y\": 40, \"aperture_radius\": 0.05, \"focus_distance\": 3"));
     writeFile(dir + "/pinhole.json", scene(kSphere));
-    EXPECT_EQ(runWedge("render " + dir + "/lens.json --spp 64 --layers on --quiet --max-memory 128K -o " + dir + "/a.png", nullptr, &err), 2);
-    EXPECT_NE(err.find("lens.json: a 8x8 mc render keeping its 64 samples a pixel for the layers (--layers) needs 171.8 KiB, "
+    EXPECT_EQ(runWedge("render " + dir + "/lens.json --spp 64 --layers on --threads 1 --quiet --max-memory 128K -o " + dir + "/a.png", nullptr, &err),
+              2);
+    EXPECT_NE(err.find("lens.json: a 8x8 mc render keeping its 64 samples a pixel for the layers (--layers) needs 436.0 KiB, "
                        "more than the memory limit of 128.0 KiB (--max-memory)"),
               std::string::npos)
         << err;

@@ -1272,6 +1272,67 @@ LightFieldSamples randomLightField(int w, int h, uint32_t spp, uint32_t seed, Sa
 
 }  // namespace
 
+TEST(Layers, ALayersGridsAreStoredOnlyAroundTheCellsItsSamplesReach) {
+    // Three small discs (radius 4 px) moving 90 px along x, one also 40 px down, over a far wall
+    // (slope -4 px) and a post in front (+5 px), each sample of its own random radiance. A moving
+    // layer's grid reaches as far as its motion each way, and its samples fill a streak of it:
+    // the stage stores each layer's accumulations and resolved cells only around the cells its
+    // samples reach (Layer::accWin, dWin, cellBox). The image must be the one of whole grids
+    // (LayerOptions::everyCell), to the bit, and far less must be stored.
+    const int W = 192, H = 128;
+    const ViewGeometry view = wideLensView(W, H);
+    const std::array<Vec2f, 3> centre{Vec2f{60.f, 30.f}, Vec2f{120.f, 64.f}, Vec2f{96.f, 80.f}};
+    const std::array<Vec2f, 3> motion{Vec2f{90.f, 0.f}, Vec2f{-90.f, 0.f}, Vec2f{90.f, 40.f}};
+    std::mt19937 colours(12);
+    std::uniform_real_distribution<float> uni(0.f, 1.f);
+    const LightFieldSamples lf = randomLightField<true>(W, H, 12, 11, [&](int x, int y, Vec2f film, float t, Vec2f lens) {
+        const float fx = float(x) + film.x, fy = float(y) + film.y;
+        const bool post = fx + 5.f * lens.x > 20.f && fx + 5.f * lens.x < 30.f;
+        int disc = -1;
+        for (int d = 0; d < 3 && !post && disc < 0; ++d)
+            if (sqr(fx - motion[d].x * (t - 0.5f) - centre[d].x) + sqr(fy - motion[d].y * (t - 0.5f) - centre[d].y) < 16.f) disc = d;
+        const float depth = post ? 1.f : disc >= 0 ? 1.9f + 0.02f * float(disc) : 10.f;
+        return LightFieldSample::pack(film, lens, t, depth, disc >= 0 ? motion[size_t(disc)] : Vec2f{0.f, 0.f}, Vec3f(1.f),
+                                      Vec3f(uni(colours), uni(colours), uni(colours)), post ? 1 : 0);
+    });
+    filter::LayerOptions whole;
+    whole.everyCell = true;
+    filter::LayerStats stats, wholeStats;
+    const Image3f a = filter::reconstructLayers(filter::LayerInput{lf, view, {}}, filter::LayerOptions{}, &stats);
+    const Image3f b = filter::reconstructLayers(filter::LayerInput{lf, view, {}}, whole, &wholeStats);
+    EXPECT_GT(stats.blurredTiles, 0.5);
+    for (int y = 0; y < H; ++y)
+        for (int x = 0; x < W; ++x) {
+            ASSERT_TRUE(isFinite(a(x, y))) << x << ", " << y;
+            ASSERT_EQ(std::memcmp(&a(x, y), &b(x, y), sizeof(Vec3f)), 0) << x << ", " << y;
+        }
+    EXPECT_DOUBLE_EQ(wholeStats.gridShare, 1.0);
+    EXPECT_LT(stats.gridShare, 0.25) << stats.gridShare;
+    // (A tile's gathered samples and its motion grids are stored whole either way.)
+    EXPECT_LT(stats.largestTileBytes, 0.75 * wholeStats.largestTileBytes) << stats.largestTileBytes << " " << wholeStats.largestTileBytes;
+}
+
+TEST(Layers, TheSamplesATileGathersAreWithinWhatTheMemoryCheckCounts) {
+    // A plane filling the view, near the lens (a slope of 35 px: its trajectories reach past
+    // LayerOptions::maxReach) or in focus. Each thread reserves the largest tile's gathered samples
+    // once, and the render's memory check counts gatheredBytesPerThread for them
+    // (render/memory_estimate.cpp): the bound must hold, and be reached where the blur is widest.
+    const int W = 192, H = 192, spp = 4;
+    const ViewGeometry view = wideLensView(W, H);
+    for (const float depth : {0.25f, 2.f}) {
+        const LightFieldSamples lf = randomLightField<true>(W, H, spp, 3, [&](int, int, Vec2f film, float t, Vec2f lens) {
+            return LightFieldSample::pack(film, lens, t, depth, {0.f, 0.f}, Vec3f(1.f), Vec3f(0.5f), 0);
+        });
+        filter::LayerStats stats;
+        filter::reconstructLayers(filter::LayerInput{lf, view, {}}, filter::LayerOptions{}, &stats);
+        const double bound = double(filter::gatheredSamplesPerThread(W, H, spp));
+        EXPECT_LE(stats.largestTileSamples, bound) << depth;
+        if (depth < 1.f) EXPECT_GE(stats.largestTileSamples, 0.95 * bound);  // (the widest margins)
+        else EXPECT_LT(stats.largestTileSamples, 0.5 * bound);                 // (a tile and its pad)
+        EXPECT_GT(filter::gatheredBytesPerThread(W, H, spp), uint64_t(bound) * 60);
+    }
+}
+
 TEST(Layers, SharpLayersDoNotMergeAcrossAMovingLayerBetweenThem) {
     // A still post in front (slope +1.2 px), a band moving 30 px over the shutter behind it
     // (+0.4 px) and a still wall behind both (-0.4 px): the post and the wall are sharp layers

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cassert>
+#include <climits>
 #include <cmath>
 #include <type_traits>
 #include <vector>
@@ -226,13 +227,15 @@ inline float chordReach(float g) { return 0.5f * (1.f + 0.5f * std::abs(g)); }
 [[gnu::always_inline]] inline float chordMiddle(float g) { return -0.25f * g; }
 /// Where sample s lies in the sharp image of slope c and screen motion (mx, my) of a surface
 /// whose depth changes at the relative rate g (alongChord): y = x + c u - m a(t) (film y: y - c
-/// v - m_y a(t)), a(t) = alongChord(t - 1/2, g), t - 1/2 where g = 0.
-inline Vec2f shearOf(const Gathered& s, float c, float mx, float my, float g) {
+/// v - m_y a(t)), a(t) = alongChord(t - 1/2, g), t - 1/2 where g = 0. (Always inlined, as
+/// layerPosition: left to the compiler, a call per sample and layer in the still layers' D pass
+/// made docs/bunny-near.json's stage 9% slower.)
+[[gnu::always_inline]] inline Vec2f shearOf(const Gathered& s, float c, float mx, float my, float g) {
     const float dt = alongChord(s.t - 0.5f, g);
     return {s.x + c * s.u - mx * dt, s.y - c * s.v - my * dt};
 }
 /// Where sample s lies in a layer's grid: its own position in a sharp layer, else its shear.
-inline Vec2f layerPosition(const Gathered& s, bool sharp, float c, float mx, float my, float g) {
+[[gnu::always_inline]] inline Vec2f layerPosition(const Gathered& s, bool sharp, float c, float mx, float my, float g) {
     return sharp ? Vec2f{s.x, s.y} : shearOf(s, c, mx, my, g);
 }
 /// Arcs of a large turn. The parabola of curvedShift is the arc's limit for a small turn; a
@@ -362,6 +365,7 @@ struct CellBox {
         if (empty()) return *this;
         return {std::max(0, x0 - rx), std::max(0, y0 - ry), std::min(gw, x1 + rx), std::min(gh, y1 + ry)};
     }
+    CellBox shifted(int dx, int dy) const { return {x0 + dx, y0 + dy, x1 + dx, y1 + dy}; }
     CellBox united(const CellBox& b) const {
         if (empty()) return b;
         if (b.empty()) return *this;
@@ -540,6 +544,27 @@ struct Layer {
     // (accD): every sample behind the layer adds to it, at scattered cells, and a 4-byte cell
     // keeps those writes in cache (a moving layer's accumulated cell is 136 bytes).
     std::vector<float> acc, accD, cell;
+    // `cell` holds the cells of cellBox alone (row-major, cellBox's width a row): the box
+    // resolveCells resolved, grown by one cell within the grid. Every other cell resolves to what
+    // that ring's do (alpha 0, no light, the layer's slope), so a lookup beyond the box reads the
+    // nearest cell of it (cellAt): the values of a whole grid, in the part of its memory its
+    // samples reach (docs/layers.md, "Memory per thread").
+    CellBox cellBox;
+    // acc holds the cells of accWin alone (row-major, accWin's width a row): the cells its own
+    // samples land in, grown by as far as its Gaussians carry them; accD those of dWin, grown
+    // farther, by the Ds that can change its coverage (dMargin), their Gaussian and
+    // resolveCells' rings, within the grid (reconstructLayers, before the splat). Beyond accWin
+    // acc is zero; a D beyond dWin is not counted: it would change nothing (dMargin says why).
+    CellBox accWin, dWin;
+    /// The index in acc (times accStride) of the grid's cell (i, j), within accWin; in accD, within dWin.
+    int accAt(int i, int j) const { return (j - accWin.y0) * (accWin.x1 - accWin.x0) + (i - accWin.x0); }
+    int dAt(int i, int j) const { return (j - dWin.y0) * (dWin.x1 - dWin.x0) + (i - dWin.x0); }
+    bool inAcc(int i, int j) const { return i >= accWin.x0 && i < accWin.x1 && j >= accWin.y0 && j < accWin.y1; }
+    /// The index in `cell` of the grid's cell (i, j), or of the nearest one cellBox holds.
+    size_t cellAt(int i, int j) const {
+        const int w = cellBox.x1 - cellBox.x0;
+        return size_t(std::clamp(j - cellBox.y0, 0, cellBox.y1 - cellBox.y0 - 1)) * size_t(w) + size_t(std::clamp(i - cellBox.x0, 0, w - 1));
+    }
     // Where acc can be non-zero: its cells with N > 0, since a sample adds to every channel at
     // one cell (CellBox; set by the D passes, which count those cells anyway).
     CellBox accBox;
@@ -604,7 +629,12 @@ struct Layer {
 
     void buildCovered() {
         const int cs = cellStride();
-        summedArea(gw, gh, covered, [&](int i, int j) { return cell[(size_t(j) * gw + i) * cs] > 0.f; });
+        // (Every cell beyond cellBox has alpha 0.)
+        const int bw = cellBox.x1 - cellBox.x0;
+        summedArea(gw, gh, covered, [&](int i, int j) {
+            return i >= cellBox.x0 && i < cellBox.x1 && j >= cellBox.y0 && j < cellBox.y1 &&
+                   cell[(size_t(j - cellBox.y0) * size_t(bw) + size_t(i - cellBox.x0)) * size_t(cs)] > 0.f;
+        });
         if (!emitCells.empty()) summedArea(gw, gh, emitting, [&](int i, int j) { return emitCells[size_t(j) * gw + i] != 0; });
     }
     /// Whether any covered cell can be read by a lookup of pixel (x, y)'s rays: bilinear lookups
@@ -1319,17 +1349,27 @@ constexpr int kFillRings = 4;
 /// `box`: where acc and accD can be non-zero, grown by the rings (CellBox). Every cell beyond it
 /// resolves to alpha 0, no light and the layer's slope, and no ring reaches it: only that is set.
 void resolveCells(Layer& l, float minWeight, CellBox box) {
-    const int cells = l.gw * l.gh, as = l.accStride(), cs = l.cellStride(), bins = l.timeBins;
+    const int as = l.accStride(), cs = l.cellStride(), bins = l.timeBins;
+    // (Layer::cellBox: the box and a ring around it, at least one cell. Below, cells are indexed
+    // within it, and a neighbour beyond it is a cell no pass sets: as one beyond the grid.)
+    l.cellBox = box.empty() ? CellBox{0, 0, 1, 1} : box.grown(1, 1, l.gw, l.gh);
+    const int ww = l.cellBox.x1 - l.cellBox.x0, wh = l.cellBox.y1 - l.cellBox.y0, cells = ww * wh;
     l.cell.assign(size_t(cells) * cs, 0.f);
     for (int i = 0; i < cells; ++i) l.cell[size_t(i) * cs + size_t(cs - 1)] = l.c;
     std::vector<uint8_t> alphaOk(cells, 0), radianceOk(cells, 0);
+    // fn(i, x, y): i the cell's index in `cell`, (x, y) the grid's cell (the box lies in dWin;
+    // beyond accWin acc is zero).
+    assert(box.empty() || (box.x0 >= l.dWin.x0 && box.y0 >= l.dWin.y0 && box.x1 <= l.dWin.x1 && box.y1 <= l.dWin.y1));
     auto forEachInBox = [&](auto&& fn) {
-        for (int y = box.y0; y < box.y1; ++y)
-            for (int i = y * l.gw + box.x0; i < y * l.gw + box.x1; ++i) fn(i);
+        for (int y = box.y0; y < box.y1; ++y) {
+            const int w = (y - l.cellBox.y0) * ww - l.cellBox.x0;
+            for (int x = box.x0; x < box.x1; ++x) fn(w + x, x, y);
+        }
     };
-    forEachInBox([&](int i) {
-        const float* a = &l.acc[size_t(i) * as];
-        const float d = l.accD[i];
+    static constexpr float kNoAcc[2 + 4 * kTimeBins] = {};
+    forEachInBox([&](int i, int x, int y) {
+        const float* a = l.inAcc(x, y) ? &l.acc[size_t(l.accAt(x, y)) * as] : kNoAcc;
+        const float d = l.accD[size_t(l.dAt(x, y))];
         float* c = &l.cell[size_t(i) * cs];
         c[cs - 1] = a[0] >= minWeight ? a[1] / a[0] : l.c;
         if (d >= minWeight) {
@@ -1359,7 +1399,7 @@ void resolveCells(Layer& l, float minWeight, CellBox box) {
     // the cell has alpha).
     auto isHole = [&](int i) { return !alphaOk[i] || (!radianceOk[i] && l.cell[size_t(i) * cs] > 0.f); };
     std::vector<int> holes;
-    forEachInBox([&](int i) {
+    forEachInBox([&](int i, int, int) {
         if (isHole(i)) holes.push_back(i);
     });
     // Per ring, the holes that have a valid neighbour and the means they take. Most holes of a
@@ -1379,14 +1419,14 @@ void resolveCells(Layer& l, float minWeight, CellBox box) {
         fills.clear();
         values.clear();
         for (const int i : holes) {
-            const int x = i % l.gw, y = i / l.gw;
+            const int x = i % ww, y = i / ww;
             std::fill_n(v, cs, 0.f);
             int nA = 0, nL = 0;
             for (int dy = -1; dy <= 1; ++dy)
                 for (int dx = -1; dx <= 1; ++dx) {
                     const int xx = x + dx, yy = y + dy;
-                    if ((dx == 0 && dy == 0) || xx < 0 || yy < 0 || xx >= l.gw || yy >= l.gh) continue;
-                    const int q = yy * l.gw + xx;
+                    if ((dx == 0 && dy == 0) || xx < 0 || yy < 0 || xx >= ww || yy >= wh) continue;
+                    const int q = yy * ww + xx;
                     const float* c = &l.cell[size_t(q) * cs];
                     if (!alphaOk[i] && alphaOk[q]) v[0] += c[0], ++nA;
                     if (!radianceOk[i] && radianceOk[q]) {
@@ -1414,12 +1454,12 @@ void resolveCells(Layer& l, float minWeight, CellBox box) {
         // The holes next to a cell filled in this ring, in the order of the cells.
         next.clear();
         for (const Fill& f : fills) {
-            const int x = f.cell % l.gw, y = f.cell / l.gw;
+            const int x = f.cell % ww, y = f.cell / ww;
             for (int dy = -1; dy <= 1; ++dy)
                 for (int dx = -1; dx <= 1; ++dx) {
                     const int xx = x + dx, yy = y + dy;
-                    if (xx < 0 || yy < 0 || xx >= l.gw || yy >= l.gh) continue;
-                    const int q = yy * l.gw + xx;
+                    if (xx < 0 || yy < 0 || xx >= ww || yy >= wh) continue;
+                    const int q = yy * ww + xx;
                     if (seen[size_t(q)] == ring || !isHole(q)) continue;
                     seen[size_t(q)] = int8_t(ring);
                     next.push_back(q);
@@ -1429,7 +1469,7 @@ void resolveCells(Layer& l, float minWeight, CellBox box) {
         holes.swap(next);
     }
     // Premultiply; what is still without radiance is taken as uncovered.
-    forEachInBox([&](int i) {
+    forEachInBox([&](int i, int, int) {
         float* c = &l.cell[size_t(i) * cs];
         if (!radianceOk[i]) c[0] = 0.f;
         for (int k = 1; k < cs - 1; ++k) c[k] *= c[0];
@@ -1454,6 +1494,7 @@ struct Blend {
 struct Bilinear {
     int cell[4];
     float w[4];
+    int stored[4];  // ... the cells' indices in Layer::cell (Layer::cellAt)
 };
 /// std::clamp and std::min by value: the same results, and no references for the SIMD loops'
 /// if-conversion to trip on (traceBlurred).
@@ -1473,7 +1514,13 @@ struct Bilinear {
     // A blurred layer's grid is at least 7 cells a side (its tile and a margin of at least
     // ceil(3 sigma) + 1 = 3 cells each way), so the next cell along either axis is inside it.
     const int c00 = j0 * l.gw + i0;
-    return {{c00, c00 + 1, c00 + l.gw, c00 + l.gw + 1}, {(1 - ax) * (1 - ay), ax * (1 - ay), (1 - ax) * ay, ax * ay}};
+    // (Layer::cellAt of the four.)
+    const int bx = l.cellBox.x0, by = l.cellBox.y0, bw = l.cellBox.x1 - bx, bh = l.cellBox.y1 - by;
+    const int a0 = minValue(maxValue(i0 - bx, 0), bw - 1), a1 = minValue(maxValue(i0 + 1 - bx, 0), bw - 1);
+    const int r0 = minValue(maxValue(j0 - by, 0), bh - 1) * bw, r1 = minValue(maxValue(j0 + 1 - by, 0), bh - 1) * bw;
+    return {{c00, c00 + 1, c00 + l.gw, c00 + l.gw + 1},
+            {(1 - ax) * (1 - ay), ax * (1 - ay), (1 - ax) * ay, ax * ay},
+            {r0 + a0, r0 + a1, r1 + a0, r1 + a1}};
 }
 /// The AffineMotion of a grid's unsmoothed sums of 2-vectors (gw x gh cells of 1 pixel; cell i's
 /// count at count[i cs], its sums of x and y at sums[i ss] and sums[i ss + 1]: a motion grid's
@@ -1627,7 +1674,7 @@ struct TimeLerp {
 /// A sharp layer's cell of pixel (x, y) at shutter time t.
 Lookup lookupSharp(const Layer& l, int x, int y, float t) {
     const TimeLerp tl = timeLerp(l.timeBins, t);
-    const float* c = &l.cell[(size_t(y - l.gy0) * l.gw + size_t(x - l.gx0)) * l.cellStride()];
+    const float* c = &l.cell[l.cellAt(x - l.gx0, y - l.gy0) * size_t(l.cellStride())];
     const float* r0 = c + 1 + 3 * tl.b0;
     if (tl.b1 == tl.b0) return {c[0], Vec3f(r0[0], r0[1], r0[2])};
     const float* r1 = c + 1 + 3 * tl.b1;
@@ -1794,7 +1841,7 @@ void traceBlurredRays(const Layer& l, const Rays& ray, int j0, int j1, const Ble
             if constexpr (kFollow) {
                 float slope = 0;
 #pragma GCC unroll 4
-                for (int k = 0; k < 4; ++k) slope += b.w[k] * cell[b.cell[k] * cs + cs - 1];
+                for (int k = 0; k < 4; ++k) slope += b.w[k] * cell[b.stored[k] * cs + cs - 1];
                 // (Linear in the table's copy, written out: a Shaped returned by a helper kept the
                 // loop scalar.)
                 const float at = clampValue((slope - l.shearFrom) * l.shearScale, 0.f, float(Layer::kShearSteps) - 1e-3f);
@@ -1832,7 +1879,7 @@ void traceBlurredRays(const Layer& l, const Rays& ray, int j0, int j1, const Ble
         float alpha = 0, r = 0, g = 0, bl = 0;
 #pragma GCC unroll 4  // (an inner loop would keep the outer one from vectorising)
         for (int k = 0; k < 4; ++k) {
-            const int c = b.cell[k] * cs;  // indices from one base: gathers
+            const int c = b.stored[k] * cs;  // indices from one base: gathers
             const float w = b.w[k];
             alpha += w * cell[c];
             const int c0 = c + 1 + 3 * b0;
@@ -1976,17 +2023,19 @@ struct MotionBatch {
     alignas(64) int cell[kMax];
     int n = 0;
 };
-/// The cells of layer l the batch's samples count in D (-1: none), as one SIMD loop: the
+/// The cells of layer l the batch's samples count in D (its accD's index; -1: none), as one SIMD loop: the
 /// point p of the sharp image with q = p + dt m(p) (motionShift, then one step on the grid's
 /// motion), and -1 where no cell within `margin` of p's has samples of the layer (`occupied`:
-/// their count summed over rectangles, (gw + 1) x (gh + 1)), since such a D changes nothing the
+/// their count summed over rectangles of its accWin, where they lie: (aw + 1) x (ah + 1)), since such a D changes nothing the
 /// layer's coverage reads (reconstructLayers). p lies within |dt| maxMotion of q (|m| <=
 /// maxMotion, a bilinear mean of the grid's motions), so that test needs no solve; a cell to
 /// spare for rounding.
 /// (kCurved: the layer's points on their arcs, Layer::sagGrid, as a ray's.)
 template <bool kCurved>
 void motionCells(const Layer& l, const int* occupied, int margin, MotionBatch& b) {
-    const int gw = l.gw, gh = l.gh, ow = gw + 1, n = b.n;
+    const int n = b.n;
+    const int wx0 = l.dWin.x0, wy0 = l.dWin.y0, ww = l.dWin.x1 - wx0, wh = l.dWin.y1 - wy0;
+    const int ax0 = l.accWin.x0, ay0 = l.accWin.y0, aw = l.accWin.x1 - ax0, ah = l.accWin.y1 - ay0, ow = aw + 1;
     const float inv = l.invStep;  // (pixels to cells)
     const AffineMotion fit = l.motionFit, sagFit = l.sagFit;
     const ArcPace pace = l.arc;  // (a copy out of the loop, as the fits)
@@ -1998,9 +2047,9 @@ void motionCells(const Layer& l, const int* occupied, int margin, MotionBatch& b
         const float d = b.t[j] - 0.5f, k = kCurved ? pace.arc(d) : 4.f * d * d;  // (kCurved)
         const int i0 = int(std::floor((qx - r) * inv)) - l.gx0 - margin, i1 = int(std::floor((qx + r) * inv)) - l.gx0 + margin;
         const int j0 = int(std::floor((qy - r) * inv)) - l.gy0 - margin, j1 = int(std::floor((qy + r) * inv)) - l.gy0 + margin;
-        // The rectangle clamped to the grid (empty where it misses the grid).
-        const int a0 = minValue(gw, maxValue(0, i0)), a1 = minValue(gw, maxValue(0, i1 + 1));
-        const int c0 = minValue(gh, maxValue(0, j0)), c1 = minValue(gh, maxValue(0, j1 + 1));
+        // The rectangle clamped to accWin (empty where it misses it: no cell beyond has samples).
+        const int a0 = minValue(aw, maxValue(0, i0 - ax0)), a1 = minValue(aw, maxValue(0, i1 + 1 - ax0));
+        const int c0 = minValue(ah, maxValue(0, j0 - ay0)), c1 = minValue(ah, maxValue(0, j1 + 1 - ay0));
         const int samples = occupied[c1 * ow + a1] - occupied[c1 * ow + a0] - occupied[c0 * ow + a1] + occupied[c0 * ow + a0];
         const Vec2f shift = kCurved ? curvedMotionShift(fit, sagFit, qx, qy, dt, k, Vec2f{l.mx * dt, l.my * dt})
                                     : motionShift(fit, qx, qy, dt, Vec2f{l.mx * dt, l.my * dt});
@@ -2016,8 +2065,10 @@ void motionCells(const Layer& l, const int* occupied, int margin, MotionBatch& b
         }
         // (gridCell's cell, with its tests as one mask for the SIMD loop.)
         const int ci = int(std::floor(px * inv)) - l.gx0, cj = int(std::floor(py * inv)) - l.gy0;
-        const int counts = int(unsigned(ci) < unsigned(gw)) & int(unsigned(cj) < unsigned(gh)) & int(samples > 0);
-        b.cell[j] = counts ? cj * gw + ci : -1;
+        // (Within the layer's dWin, beyond which a D changes nothing: Layer::dWin.)
+        const int ai = ci - wx0, aj = cj - wy0;
+        const int counts = int(unsigned(ai) < unsigned(ww)) & int(unsigned(aj) < unsigned(wh)) & int(samples > 0);
+        b.cell[j] = counts ? aj * ww + ai : -1;
     }
 }
 
@@ -2058,6 +2109,31 @@ Image<uint8_t> pixelsAwayFromSilhouettes(const Image<uint8_t>& mixed, int reach)
     Image<uint8_t> out = dilateBox(mixed, reach);
     for (size_t i = 0; i < out.size(); ++i) out[i] = !out[i];
     return out;
+}
+
+namespace {
+/// What a tile's margin adds to the trajectories' reach for its grids' Gaussians, pixels.
+float gridPad(const LayerOptions& o) { return std::ceil(3.f * o.sigmaMax) + 2.f; }
+/// A gathered sample and its scratch: its layer (sampleLayer) and its cell (ownCell).
+constexpr uint64_t kGatheredBytes = sizeof(Gathered) + sizeof(uint16_t) + sizeof(uint32_t);
+}  // namespace
+
+namespace {
+/// The pixels of the largest region a tile gathers.
+uint64_t largestRegion(int width, int height, const LayerOptions& o) {
+    // (A tile's margin is its trajectories' reach, at most maxReach, and the pad: reconstructLayers.)
+    const int margin = int(std::ceil(float(o.maxReach) + gridPad(o)));
+    return uint64_t(std::min(width, o.tile + 2 * margin)) * uint64_t(std::min(height, o.tile + 2 * margin));
+}
+}  // namespace
+
+uint64_t gatheredSamplesPerThread(int width, int height, double samplesPerPixel, const LayerOptions& o) {
+    return uint64_t(std::ceil(double(largestRegion(width, height, o)) * samplesPerPixel));
+}
+
+uint64_t gatheredBytesPerThread(int width, int height, double samplesPerPixel, const LayerOptions& o) {
+    return gatheredSamplesPerThread(width, height, samplesPerPixel, o) * kGatheredBytes +
+           (largestRegion(width, height, o) + 1) * sizeof(uint32_t);  // (and pixelStart)
 }
 
 Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStats* stats, Image<uint8_t>* own) {
@@ -2132,8 +2208,9 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
         });
     }
     std::atomic<uint64_t> gatheredTotal{0}, layerTotal{0}, blurredTotal{0}, straddlingTotal{0}, leftTotal{0}, multiRayTotal{0}, rayTotal{0};
+    std::atomic<uint64_t> largestTileBytes{0}, gridFloats{0}, wholeGridFloats{0};  // (LayerStats)
     const int apronTiles = (o.maxReach + T - 1) / T;
-    const float pad = std::ceil(3.f * o.sigmaMax) + 2.f;
+    const float pad = gridPad(o);
     // Each tile's margin per axis: the reach of the trajectories that can touch it, and a pad
     // for the grids' Gaussians.
     std::vector<std::array<int, 2>> tileMargin(size_t(tilesX) * tilesY, {0, 0});
@@ -2206,6 +2283,8 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
         std::vector<std::vector<int>> occupied;
         std::vector<MotionBatch> batch;
         std::vector<uint16_t> sampleLayer;  // per gathered sample: its layer (Split::layerOf)
+        std::vector<uint32_t> ownCell;      // ... and the cell of its layer's grid it is splatted in (j << 16 | i, a grid at most
+                                            // tile + 2 maxGridMargin cells a side; kOffGrid: none)
         std::vector<uint32_t> pixelStart;   // per pixel of the tile's region (row-major), and one past: its first sample in g
         std::vector<int> occupiedStill;     // the D pass of the other layers: a layer's cells with samples summed over rectangles,
         std::vector<uint8_t> near;          // ... and its cells within the margin of one
@@ -2767,8 +2846,7 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                     // (A sharp layer's pixels take one ray where the whole tile is sharp: its
                     // radiance is its pixel's samples over the whole shutter, not one bin's.)
                     l.timeBins = l.moving && !l.sharp ? kTimeBins : 1;
-                    l.acc.assign(size_t(l.gw) * l.gh * l.accStride(), 0.f);
-                    l.accD.assign(size_t(l.gw) * l.gh, 0.f);
+                    // (acc and accD: below, where the splat's cells are known.)
                     // The sharp band (LayerOptions::sharpBand): a blurred layer whose slope nearest
                     // focus lies below the threshold also keeps its pixels' own samples, as a
                     // sharp layer of the tile would (its twin), and each pixel blends the two by
@@ -2783,6 +2861,7 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                             t.c = l.c, t.moving = l.moving;  // (radianceOf's and resolveCells' reads)
                             t.sharp = true, t.timeBins = 1;
                             t.gx0 = X0, t.gy0 = Y0, t.gw = X1 - X0, t.gh = Y1 - Y0;
+                            t.accWin = t.dWin = {0, 0, t.gw, t.gh};
                             t.acc.assign(size_t(t.gw) * t.gh * t.accStride(), 0.f);
                             t.accD.assign(size_t(t.gw) * t.gh, 0.f);
                         }
@@ -2808,7 +2887,9 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                     float *acc, *d, *motion;
                     int step;
                     float invStep;
-                    int cellIndex(Vec2f p) const { return gridCell(gx0, gy0, gw, gh, p, invStep); }
+                    int ax0, ay0, aw, dx0, dy0, dw;  // (Layer::accWin and dWin: their origins and widths)
+                    int accIndex(int i, int j) const { return (j - ay0) * aw + (i - ax0); }
+                    int dIndex(int i, int j) const { return (j - dy0) * dw + (i - dx0); }
                     bool inFrontOfAll(float q, float t) const { return moving && inFrontOfMoving(invDepthMax, depthRate, q, t); }
                 };
                 if (o.crispAcrossMotion && anyMotionGrid) {
@@ -2838,12 +2919,79 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                         l.shapeRays(l.motionRms);
                     }
                 }
+                // Each sample's layer and the cell of its layer's grid it is splatted in (below), and
+                // per layer the box of those cells: its acc and accD hold that box grown by as far
+                // as the passes after carry what can change its cells (Layer::accWin, dWin): a moving
+                // layer's grid reaches as far as its motion, and its samples fill a part of it (a
+                // snowflake's trail). (Over the whole grid, with up to 29 layers a tile, the
+                // tile's accumulations were 120 MB a thread on docs/snow.json; docs/layers.md,
+                // "Memory per thread".)
+                constexpr uint32_t kOffGrid = ~0u;
+                std::vector<uint16_t>& sampleLayer = local.sampleLayer;
+                sampleLayer.resize(g.size());
+                // Its own layer's N, D, W and radiance at its own trajectory's point. (A turning
+                // object's sample on its arc: only in a layer with a motion grid, whose rays and
+                // D follow the grid's sagittas.)
+                auto ownCellOf = [&](const Gathered& s, int sl) __attribute__((always_inline)) {  // (called in the splat: a call per sample cost 1% of conference AAF)
+                    const Layer& l = layers[size_t(sl)];
+                    Vec2f own = layerPosition(s, l.sharp, s.c, s.mx, s.my, l.depthRate);
+                    if (!motionAcc[size_t(sl)].empty() && curved(s)) {
+                        const Vec2f shift = curvedShift(l.arc, {s.mx, s.my}, effectiveSag(s, l.depthRate), alongChord(s.t - 0.5f, l.depthRate), s.t);
+                        own = {own.x + shift.x, own.y + shift.y};
+                    }
+                    const int ci = int(std::floor(own.x * l.invStep)) - l.gx0, cj = int(std::floor(own.y * l.invStep)) - l.gy0;  // (gridCell)
+                    return ci < 0 || cj < 0 || ci >= l.gw || cj >= l.gh ? kOffGrid : uint32_t(cj) << 16 | uint32_t(ci);
+                };
+                // Only in a tile with a blurred moving layer: a still layer's grid reaches at most
+                // stillGridReach cells beyond its tile, and on docs/bunny-near.json and conference
+                // (lens blur alone) the pass over the samples it needs made the stage 10% slower.
+                const bool windows = !o.everyCell && !countEveryD &&
+                                     std::any_of(layers.begin(), layers.end(), [](const Layer& l) { return l.moving && !l.sharp; });
+                std::vector<uint32_t>& ownCell = local.ownCell;
+                std::vector<CellBox> splatBox(layers.size(), CellBox{INT_MAX, INT_MAX, INT_MIN, INT_MIN});
+                if (windows) {
+                    ownCell.resize(g.size());
+                    for (size_t i = 0; i < g.size(); ++i) {
+                        const Gathered& s = g[i];
+                        const int sl = split.layerOf(s);
+                        sampleLayer[i] = uint16_t(sl);
+                        const uint32_t c = ownCell[i] = ownCellOf(s, sl);
+                        if (c == kOffGrid) continue;
+                        const int ci = int(c & 0xffffu), cj = int(c >> 16);
+                        CellBox& b = splatBox[size_t(sl)];
+                        b = {std::min(b.x0, ci), std::min(b.y0, cj), std::max(b.x1, ci + 1), std::max(b.y1, cj + 1)};
+                    }
+                }
+                for (size_t k = 0; k < layers.size(); ++k) {
+                    Layer& l = layers[k];
+                    const CellBox& b = splatBox[k];
+                    if (!windows) {
+                        l.accWin = l.dWin = {0, 0, l.gw, l.gh};
+                    } else if (b.empty()) {
+                        l.accWin = l.dWin = {};
+                    } else {
+                        // The radiance's Gaussians (sigma, then the edge-stopping one along each
+                        // axis) or the coverage's (sigmaCoverage); for D, the Ds dMargin counts
+                        // and their Gaussian, and resolveCells' rings beyond (whose box lies
+                        // within dWin).
+                        const int coverage = l.sharp ? 0 : int(std::ceil(3.f * l.sigmaCoverage));
+                        const float width = l.moving ? o.movingEdgeWidth : o.stillEdgeWidth;
+                        const int radiance = l.sharp ? 0 : int(std::ceil(3.f * l.sigma)) + (width > 0.f ? int(std::ceil(3.f * width * l.sigma)) : 0);
+                        const int ra = std::max(coverage, radiance), rd = std::max(dMargin(l) + coverage, ra) + kFillRings;
+                        l.accWin = b.grown(ra, ra, l.gw, l.gh);
+                        l.dWin = b.grown(rd, rd, l.gw, l.gh);
+                    }
+                    auto cellsOf = [](const CellBox& w) { return w.empty() ? size_t(0) : size_t(w.x1 - w.x0) * size_t(w.y1 - w.y0); };
+                    l.acc.assign(cellsOf(l.accWin) * size_t(l.accStride()), 0.f);
+                    l.accD.assign(cellsOf(l.dWin), 0.f);
+                }
                 std::vector<SplatTarget> target(layers.size());
                 for (size_t k = 0; k < layers.size(); ++k) {
                     Layer& l = layers[k];
                     target[k] = {l.c,        l.mx,         l.my,  l.depthRate, l.invDepthMax,   l.gx0,     l.gy0,       l.gw,
                                  l.gh,       l.accStride(), l.timeBins, l.sharp,  l.moving,    l.acc.data(),
-                                 l.accD.data(), motionAcc[k].empty() ? nullptr : motionAcc[k].data(), l.step, l.invStep};
+                                 l.accD.data(), motionAcc[k].empty() ? nullptr : motionAcc[k].data(), l.step, l.invStep,
+                                 l.accWin.x0, l.accWin.y0, l.accWin.x1 - l.accWin.x0, l.dWin.x0, l.dWin.y0, l.dWin.x1 - l.dWin.x0};
                 }
                 // The layer of each of the tile's textured pixels' surfaces, where all of its
                 // samples there are in one (-2: in several): there a sample in a sharp layer
@@ -2878,27 +3026,18 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                     }
                     return radianceOf(s, l);
                 };
-                // (Each sample's layer kept for the D pass of the layers with a motion grid.)
-                std::vector<uint16_t>& sampleLayer = local.sampleLayer;
-                sampleLayer.resize(g.size());
+                // (The samples' layers, sampleLayer, are kept for the D passes.)
                 for (size_t i = 0; i < g.size(); ++i) {
                     const Gathered& s = g[i];
-                    const int sl = split.layerOf(s);
-                    sampleLayer[i] = uint16_t(sl);
-                    // Its own layer's N, D, W and radiance at its own trajectory's point.
+                    const int sl = windows ? int(sampleLayer[i]) : split.layerOf(s);
+                    const uint32_t own = windows ? ownCell[i] : ownCellOf(s, sl);
+                    if (!windows) sampleLayer[i] = uint16_t(sl);
+                    if (own == kOffGrid) continue;
                     const SplatTarget& l = target[size_t(sl)];
-                    Vec2f own = layerPosition(s, l.sharp, s.c, s.mx, s.my, l.depthRate);
-                    // (A turning object's sample on its arc: only in a layer with a motion grid,
-                    // whose rays and D follow the grid's sagittas.)
-                    const bool arc = l.motion && curved(s);
-                    const Vec2f e = arc ? effectiveSag(s, l.depthRate) : Vec2f{0.f, 0.f};
-                    if (arc) {
-                        const Vec2f shift = curvedShift(layers[size_t(sl)].arc, {s.mx, s.my}, e, alongChord(s.t - 0.5f, l.depthRate), s.t);
-                        own = {own.x + shift.x, own.y + shift.y};
-                    }
-                    const int ci = l.cellIndex(own);
-                    if (ci < 0) continue;
-                    if (arc) {
+                    const int cx = int(own & 0xffffu), cy = int(own >> 16);
+                    const int ci = cy * l.gw + cx, ai = l.accIndex(cx, cy), di = l.dIndex(cx, cy);  // (its index in the grid, in acc and in accD)
+                    if (l.motion && curved(s)) {
+                        const Vec2f e = effectiveSag(s, l.depthRate);
                         std::vector<float>& sa = sagAcc[size_t(sl)];
                         if (sa.empty()) sa.assign(size_t(l.gw) * l.gh * 2, 0.f);
                         sa[size_t(ci) * 2] += e.x;
@@ -2908,7 +3047,7 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                         float* m = l.motion + size_t(ci) * 3;
                         m[0] += 1.f, m[1] += s.mx, m[2] += s.my;
                     }
-                    splatCell(l.acc + size_t(ci) * l.accStride, l.d[ci], s.c, timeBinOf(l.timeBins, s.t), splatRadiance(s, sl, l));
+                    splatCell(l.acc + size_t(ai) * l.accStride, l.d[di], s.c, timeBinOf(l.timeBins, s.t), splatRadiance(s, sl, l));
                     if (LightFieldSample::carriesEmission(s.albedo, s.radiance) && !l.sharp) {  // (LayerOptions::emitterRays)
                         std::vector<uint8_t>& e = layers[size_t(sl)].emitCells;
                         if (e.empty()) e.assign(size_t(l.gw) * l.gh, 0);
@@ -2980,7 +3119,8 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                     const SplatTarget& l = target[size_t(k)];
                     if (l.motion) continue;
                     const int gw = l.gw, gh = l.gh;
-                    summedArea(gw, gh, occupiedStill, [&](int i, int j) { return l.acc[(size_t(j) * gw + i) * l.accStride] > 0.f; });
+                    const Layer& layer = layers[size_t(k)];
+                    summedArea(gw, gh, occupiedStill, [&](int i, int j) { return layer.inAcc(i, j) && l.acc[size_t(l.accIndex(i, j)) * l.accStride] > 0.f; });
                     layers[size_t(k)].accBox = summedBox(occupiedStill, gw, gh);
                     if (occupiedStill.back() == 0) continue;  // no samples of its own: alpha 0 whatever D is
                     const int m = dMargin(layers[size_t(k)]);
@@ -3005,8 +3145,10 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                     const float nearest = layers[size_t(k)].invDepthMax;
                     forEachBehind(k, wx0, wx1, wy0, wy1, [&](const Gathered& s, int sl) {
                         if (farthest[size_t(sl)] >= nearest && l.inFrontOfAll(s.invDepth, s.t)) return;
-                        const int ci = l.cellIndex(layerPosition(s, l.sharp, l.c, l.mx, l.my, l.depthRate));
-                        if (ci >= 0 && near[size_t(ci)]) l.d[ci] += 1.f;
+                        const Vec2f p = layerPosition(s, l.sharp, l.c, l.mx, l.my, l.depthRate);
+                        const int ci = int(std::floor(p.x * l.invStep)) - l.gx0, cj = int(std::floor(p.y * l.invStep)) - l.gy0;  // (gridCell)
+                        if (ci < 0 || cj < 0 || ci >= gw || cj >= gh || !near[size_t(cj) * gw + size_t(ci)]) return;
+                        l.d[l.dIndex(ci, cj)] += 1.f;  // (a cell `near` counts lies within dWin)
                     });
                 }
                 if (anyMotionGrid) {
@@ -3074,6 +3216,10 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                             }
                             l.maxSag = std::sqrt(most);
                         }
+                        // (The sums are done with: their grids are built. The layers with a motion
+                        // grid are those with motionGrid from here.)
+                        motionAcc[k] = std::vector<float>();
+                        sagAcc[k] = std::vector<float>();
                     }
                     // Each sample's point on the layers in front of it goes into that layer's
                     // batch, and a full batch's cells are found by one SIMD loop (motionCells):
@@ -3087,7 +3233,7 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                     std::vector<int>& withGrid = local.withGrid;  // the layers with a motion grid, front to back
                     withGrid.clear();
                     for (int k = 0; k < nLayers; ++k)
-                        if (!motionAcc[size_t(k)].empty()) withGrid.push_back(k);
+                        if (!layers[size_t(k)].motionGrid.empty()) withGrid.push_back(k);
                     std::vector<std::vector<int>>& occupied = local.occupied;
                     std::vector<MotionBatch>& batch = local.batch;
                     if (occupied.size() < size_t(nLayers)) occupied.resize(size_t(nLayers));
@@ -3104,11 +3250,12 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                     ownBox.assign(size_t(nLayers), {kInf, kInf, -kInf, -kInf});
                     for (const int k : withGrid) {
                         const Layer& l = layers[size_t(k)];
-                        const int gw = l.gw, gh = l.gh, as = l.accStride();
-                        std::vector<int>& o = occupied[size_t(k)];
-                        summedArea(gw, gh, o, [&](int i, int j) { return l.acc[(size_t(j) * gw + i) * as] > 0.f; });
+                        const int aw = l.accWin.x1 - l.accWin.x0, ah = l.accWin.y1 - l.accWin.y0, as = l.accStride();
+                        std::vector<int>& o = occupied[size_t(k)];  // (over accWin: no cell beyond has samples)
+                        summedArea(aw, ah, o, [&](int i, int j) { return l.acc[(size_t(j) * aw + i) * as] > 0.f; });
                         // The box of those cells.
-                        const CellBox cellsBox = summedBox(o, gw, gh);
+                        const CellBox inWin = summedBox(o, aw, ah);
+                        const CellBox cellsBox = inWin.empty() ? CellBox{} : inWin.shifted(l.accWin.x0, l.accWin.y0);
                         layers[size_t(k)].accBox = cellsBox;
                         const int bx0 = cellsBox.x0, by0 = cellsBox.y0, bx1 = cellsBox.x1 - 1, by1 = cellsBox.y1 - 1;
                         const int m = dMargin(l);
@@ -3211,32 +3358,45 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                         if (ci >= 0) t.accD[size_t(ci)] += 1.f;
                     });
                 }
+                // (LayerStats::largestTileBytes, gridShare.)
+                uint64_t tileBytes = uint64_t(g.size()) * sizeof(Gathered), tileFloats = 0, tileWhole = 0;
                 for (Layer& l : layers) {
-                    // Each pass within the cells it can change (CellBox): the same sums.
-                    const CellBox grid{0, 0, l.gw, l.gh};
-                    CellBox box = o.everyCell ? grid : l.accBox, boxD = o.everyCell ? grid : nonZeroBox(l.accD, l.gw, l.gh);
+                    tileFloats += l.acc.size() + l.accD.size();
+                    tileWhole += uint64_t(l.gw) * uint64_t(l.gh) * uint64_t(l.accStride() + 1 + l.cellStride());
+                    tileBytes += (l.acc.size() + l.accD.size()) * sizeof(float);
+                }
+                for (Layer& l : layers) {
+                    // Each pass within the cells it can change (CellBox): the same sums. (acc's in
+                    // the cells of accWin, whose width is a row of it, accD's in dWin's, until
+                    // resolveCells; with everyCell both are the grid.)
+                    const int aw = l.accWin.x1 - l.accWin.x0, ah = l.accWin.y1 - l.accWin.y0;
+                    const int dw = l.dWin.x1 - l.dWin.x0, dh = l.dWin.y1 - l.dWin.y0;
+                    CellBox box = o.everyCell ? CellBox{0, 0, aw, ah} : l.accBox.shifted(-l.accWin.x0, -l.accWin.y0);
+                    CellBox boxD = o.everyCell ? CellBox{0, 0, dw, dh} : nonZeroBox(l.accD, dw, dh);
                     if (!l.sharp) {
                         const float sc = l.sigmaCoverage, sr = l.sigma;
                         CellBox radiance;  // (of W, R, G, B)
                         const bool plainRadiance = l.crisp >= 0 && !o.crispRadiance;
                         if (sc == sr && !plainRadiance) {
-                            radiance = smooth(l.acc, l.gw, l.gh, l.accStride(), l.sigmaX(sr), l.sigmaY(sr), box);
+                            radiance = smooth(l.acc, aw, ah, l.accStride(), l.sigmaX(sr), l.sigmaY(sr), box);
                         } else {
-                            const CellBox coverage = smooth(l.acc, l.gw, l.gh, l.accStride(), l.sigmaX(sc), l.sigmaY(sc), box, 0, 2);  // N, the slopes
-                            radiance = smooth(l.acc, l.gw, l.gh, l.accStride(), plainRadiance ? sr : l.sigmaX(sr), plainRadiance ? sr : l.sigmaY(sr), box,
+                            const CellBox coverage = smooth(l.acc, aw, ah, l.accStride(), l.sigmaX(sc), l.sigmaY(sc), box, 0, 2);  // N, the slopes
+                            radiance = smooth(l.acc, aw, ah, l.accStride(), plainRadiance ? sr : l.sigmaX(sr), plainRadiance ? sr : l.sigmaY(sr), box,
                                               2);  // W, R, G, B
                             box = coverage;
                         }
-                        boxD = smooth(l.accD, l.gw, l.gh, 1, l.sigmaX(sc), l.sigmaY(sc), boxD);
+                        boxD = smooth(l.accD, dw, dh, 1, l.sigmaX(sc), l.sigmaY(sc), boxD);
                         // The radiance, edge-stopped along both axes (across a crisp layer's motion
                         // its only Gaussian; LayerOptions::movingEdgeWidth, stillEdgeWidth).
                         if (const float width = l.moving ? o.movingEdgeWidth : o.stillEdgeWidth; width > 0.f)
                             for (int axis = 0; axis < 2; ++axis)
-                                radiance = smoothAcrossEdges(l.acc, l.gw, l.gh, l.accStride(), 2, width * sr, axis, o.edgeStop,
+                                radiance = smoothAcrossEdges(l.acc, aw, ah, l.accStride(), 2, width * sr, axis, o.edgeStop,
                                                              0.01f * invRadianceScale, radiance);
                         box = box.united(radiance);
                     }
-                    resolveCells(l, l.sharp ? 0.5f : 0.05f, box.united(boxD).grown(kFillRings, kFillRings, l.gw, l.gh));
+                    // (In dWin's cells: accWin lies within it.)
+                    box = box.shifted(l.accWin.x0 - l.dWin.x0, l.accWin.y0 - l.dWin.y0);
+                    resolveCells(l, l.sharp ? 0.5f : 0.05f, box.united(boxD).grown(kFillRings, kFillRings, dw, dh).shifted(l.dWin.x0, l.dWin.y0));
                     l.acc = std::vector<float>();
                     l.accD = std::vector<float>();
                     if (const int tk = twinOf[size_t(&l - layers.data())]; tk >= 0) {
@@ -3247,13 +3407,16 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                         const int tcs = t.cellStride();
                         l.own.resize(size_t(t.gw) * t.gh * 5);
                         for (size_t i = 0; i < size_t(t.gw) * t.gh; ++i) {
-                            const float* c = &t.cell[i * size_t(tcs)];
+                            const float* c = &t.cell[t.cellAt(int(i % size_t(t.gw)), int(i / size_t(t.gw))) * size_t(tcs)];
                             const float w = sharpWeight(c[tcs - 1], l.motionRms, o), keep = 1.f - w;
                             float* b = &l.own[i * 5];
                             b[0] = w, b[1] = keep * c[0], b[2] = keep * c[1], b[3] = keep * c[2], b[4] = keep * c[3];
                         }
                     }
                     l.buildCovered();
+                    tileFloats += l.cell.size();
+                    tileBytes += (l.cell.size() + l.motionGrid.size() + l.sagGrid.size()) * sizeof(float) +
+                                 (l.covered.size() + l.emitting.size()) * sizeof(int) + l.emitCells.size();
                     const float slopeReach = std::max({std::abs(l.cMin), std::abs(l.cMax), std::abs(l.rayC), std::abs(l.rayC + l.rayC2)});
                     if (l.moving && !l.sharp) l.buildWindow();  // (a sharp layer's rays read its pixel's cell)
                     const float chord = chordReach(l.depthRate);
@@ -3271,6 +3434,9 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                 }
                 // A layer a pixel's rays can see; a sharp still layer is the same for every ray
                 // (its pixel's cell), looked up once.
+                gridFloats += tileFloats, wholeGridFloats += tileWhole;
+                for (uint64_t most = largestTileBytes.load(); tileBytes > most && !largestTileBytes.compare_exchange_weak(most, tileBytes);) {
+                }
                 struct Active {
                     const Layer* layer;
                     bool fixed;
@@ -3607,6 +3773,9 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
         stats->multiRayPixels = double(multiRayTotal) / pixels;
         stats->raysPerPixel = double(rayTotal) / pixels;
         stats->methodTiles = double(leftTotal) / tiles;
+        stats->largestTileBytes = double(largestTileBytes);
+        stats->gridShare = wholeGridFloats > 0 ? double(gridFloats) / double(wholeGridFloats) : 0.0;
+        stats->largestTileSamples = double(largestTile);
     }
     return out;
 }

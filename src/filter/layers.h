@@ -274,7 +274,26 @@ struct LayerStats {
     double multiRayPixels = 0;    // fraction of pixels that traced more than one reconstruction ray
     double raysPerPixel = 0;      // reconstruction rays traced, per pixel of the image
     double methodTiles = 0;       // fraction of tiles left whole to the method's own composition (LayerInput::methodPixels)
+    // What a thread holds for one tile: the largest tile's gathered samples and its layers' grids
+    // (accumulations, resolved cells, motion grids and summed-area tables, each counted whole,
+    // though a layer's accumulations are freed as its cells are resolved), bytes.
+    double largestTileBytes = 0;
+    // The layers' accumulations and resolved cells as stored (around the cells their samples
+    // reach: Layer::accWin, dWin, cellBox), over what they would be across their whole grids.
+    double gridShare = 0;
+    // The samples the largest tile gathered (its pixels and its margins), which each thread
+    // reserves once (gatheredBytesPerThread bounds it).
+    double largestTileSamples = 0;
 };
+
+/// The most samples one tile of reconstructLayers gathers: a tile and its widest margins
+/// (LayerOptions::maxReach and the Gaussians' pad) within the image, at samplesPerPixel samples a
+/// pixel.
+uint64_t gatheredSamplesPerThread(int width, int height, double samplesPerPixel, const LayerOptions& options = {});
+/// ... what a thread holds for them, bytes, with each sample's scratch. (The tile's grids come on
+/// top and depend on the scene: LayerStats::largestTileBytes; docs/layers.md, "Memory per
+/// thread".)
+uint64_t gatheredBytesPerThread(int width, int height, double samplesPerPixel, const LayerOptions& options = {});
 
 /// Whether every sample pixel `p` holds is sharp and still: its defocus blur, a disc of radius
 /// |c|, and its screen motion below the grid's own blur with the smallest Gaussian (the sharp

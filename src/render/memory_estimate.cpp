@@ -1,7 +1,11 @@
 #include "render/memory_estimate.h"
 
+#include <algorithm>
+
 #include "core/light_field.h"
 #include "core/memory_limit.h"
+#include "core/parallel.h"
+#include "filter/layers.h"
 
 namespace wedge::render {
 
@@ -24,7 +28,7 @@ constexpr uint64_t kLightFieldSampleBytes = sizeof(LightFieldSample);
 RenderMemory renderMemory(const scene::SceneDesc& desc, const RenderOptions& options) {
     const uint64_t pixels = uint64_t(desc.camera.width) * uint64_t(desc.camera.height);
     const int spp = renderSpp(desc, options);
-    uint64_t perPixel = kRenderBytesPerPixel;
+    uint64_t perPixel = kRenderBytesPerPixel, threadBytes = 0;
     RenderMemory m;
     m.what = "a " + std::to_string(desc.camera.width) + "x" + std::to_string(desc.camera.height) + " " + options.method +
              " render";
@@ -37,8 +41,11 @@ RenderMemory renderMemory(const scene::SceneDesc& desc, const RenderOptions& opt
         perPixel += uint64_t(spp) * (kLightFieldSampleBytes + (keepsSags(desc) ? sizeof(LightFieldSag) : 0)) +
                     3 * sizeof(float);  // and LightFieldSamples::bentReach and the emissions
         m.what += " keeping its " + std::to_string(spp) + " samples a pixel for the layers (--layers)";
+        // ... and each thread the samples one tile gathers, a tile and its widest margins (not
+        // the tile's grids, which depend on the scene: docs/layers.md, "Memory per thread").
+        threadBytes = filter::gatheredBytesPerThread(desc.camera.width, desc.camera.height, spp);
     }
-    m.bytes = pixels * perPixel;
+    m.bytes = pixels * perPixel + uint64_t(std::max(1, ThreadLimit::current())) * threadBytes;
     return m;
 }
 

@@ -479,6 +479,8 @@ Image3f reconstructFromLayers(const MethodContext& ctx,
     result.extra.emplace_back("layers_straddling_pixels", stats.straddlingPixels);
     result.extra.emplace_back("layers_multi_ray_pixels", stats.multiRayPixels);
     result.extra.emplace_back("layers_rays_per_pixel", stats.raysPerPixel);
+    result.extra.emplace_back("layers_largest_tile_bytes", stats.largestTileBytes);
+    result.extra.emplace_back("layers_grid_share", stats.gridShare);
     if (input.methodPixels) result.extra.emplace_back("layers_method_tiles", stats.methodTiles);
     if (perPixel)
         result.extra.emplace_back("layers_own_pixels", double(ownPixels) / double(std::max<size_t>(1, size_t(fb.width) * fb.height)));
