@@ -31,9 +31,11 @@ struct Gathered {
     int8_t surface;
     uint8_t cls;  // 0: still; 1 + g: moving, in the tile's motion group g (kMotionGroups)
     uint16_t bin;  // its slope bin in its class's histogram (splitLayers)
-    float sx, sy;  // the sagitta of a turning object's path (LightFieldSample::sag; 0 elsewhere)
+    // (The sagitta of a turning object's path, LightFieldSample::sag, is in an array of its own
+    // beside the gathered samples, where the light field keeps sagittas: 8 of 60 bytes a sample
+    // that every pass over them read, 0 in most scenes.)
 };
-static_assert(sizeof(Gathered) == 60, "the bin fits in what was padding");
+static_assert(sizeof(Gathered) == 52, "the bin fits in what was padding");
 
 /// A layer whose slopes spread less than this (pixels per unit lens coordinate) is sheared with
 /// its mean slope alone; a wider one's rays take the slope of the surface they find.
@@ -296,8 +298,8 @@ inline Vec2f curvedShift(const ArcPace& pace, Vec2f m, Vec2f e, float a, float t
     return {across * e.x - along * m.x, across * e.y - along * m.y};
 }
 /// The effective sagitta e of a sample in a layer of depth rate g (curvedShift).
-inline Vec2f effectiveSag(const Gathered& s, float g) { return {s.sx - 0.25f * g * s.mx, s.sy - 0.25f * g * s.my}; }
-inline bool curved(const Gathered& s) { return s.sx != 0.f || s.sy != 0.f; }
+inline Vec2f effectiveSag(const Gathered& s, Vec2f sag, float g) { return {sag.x - 0.25f * g * s.mx, sag.y - 0.25f * g * s.my}; }
+inline bool curved(Vec2f sag) { return sag.x != 0.f || sag.y != 0.f; }
 
 /// The time bin of shutter time t among `bins`.
 inline int timeBinOf(int bins, float t) { return std::min(bins - 1, int(t * float(bins))); }
@@ -1017,7 +1019,7 @@ int groupByMotionField(Samples& g, int x0, int y0, int x1, int y1, FieldScratch&
 /// layer and one to renumber it front to back, were a tenth of an MC render of
 /// docs/motion.json); the splat takes each sample's layer from its bin (Split::layerOf).
 template <class Samples>
-void splitLayers(Samples& g, const SlopeRange (&range)[kClasses], const float (&rate)[kClasses],
+void splitLayers(Samples& g, const Vec2f* sags, const SlopeRange (&range)[kClasses], const float (&rate)[kClasses],
                  const float (&depthRate)[kClasses], const SlopeRange (&splitRange)[kClasses], const LayerOptions& o, Split& split,
                  const SplitKey& splitKey) {
     auto& hist = split.hist;
@@ -1101,13 +1103,14 @@ void splitLayers(Samples& g, const SlopeRange (&range)[kClasses], const float (&
             r.invMax = std::max(r.invMax, s.invDepth);
             r.invMin = std::min(r.invMin, s.invDepth);
             r.motionMax = vmax(r.motionMax, Vec2f{std::abs(s.mx), std::abs(s.my)});
-            r.sagMax = vmax(r.sagMax, Vec2f{std::abs(s.sx), std::abs(s.sy)});
-            if (curved(s)) {
+            const Vec2f sag = sags ? sags[&s - g.data()] : Vec2f{0.f, 0.f};
+            r.sagMax = vmax(r.sagMax, Vec2f{std::abs(sag.x), std::abs(sag.y)});
+            if (curved(sag)) {
                 // (Its sagitta across its chord: along it a sagitta is a turn in depth's uneven
                 // pace, whose ratio to the chord depends on where the point is on its circle.)
                 const double m = std::sqrt(double(s.mx) * s.mx + double(s.my) * s.my);
                 if (m > 1e-3) {
-                    r.arcSag += std::abs(double(s.sx) * s.my - double(s.sy) * s.mx) / m;
+                    r.arcSag += std::abs(double(sag.x) * s.my - double(sag.y) * s.mx) / m;
                     r.arcMotion += m;
                 }
             }
@@ -2114,8 +2117,9 @@ Image<uint8_t> pixelsAwayFromSilhouettes(const Image<uint8_t>& mixed, int reach)
 namespace {
 /// What a tile's margin adds to the trajectories' reach for its grids' Gaussians, pixels.
 float gridPad(const LayerOptions& o) { return std::ceil(3.f * o.sigmaMax) + 2.f; }
-/// A gathered sample and its scratch: its layer (sampleLayer) and its cell (ownCell).
-constexpr uint64_t kGatheredBytes = sizeof(Gathered) + sizeof(uint16_t) + sizeof(uint32_t);
+/// A gathered sample and its scratch: its sagitta where the light field keeps them (counted
+/// always), its layer (sampleLayer) and its cell (ownCell).
+constexpr uint64_t kGatheredBytes = sizeof(Gathered) + sizeof(Vec2f) + sizeof(uint16_t) + sizeof(uint32_t);
 }  // namespace
 
 namespace {
@@ -2263,6 +2267,7 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
     struct Scratch {
         // Left unwritten when it grows; huge pages for its megabytes (LargeAllocator).
         std::vector<Gathered, UnwrittenAllocator<Gathered>> g;
+        std::vector<Vec2f, UnwrittenAllocator<Vec2f>> sag;  // per gathered sample, where the light field keeps sagittas (Gathered)
         Split split;
         std::vector<SlopeMoments> moments;  // per motion group and cell (slopeRate)
         std::vector<SlopeMoments> depthMoments;  // ... of the depth (depthRateOf)
@@ -2323,6 +2328,13 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                 if (g.capacity() < largestTile) g.reserve(largestTile);
                 g.resize(regionCount(region));
                 Gathered* next = g.data();
+                // (Their sagittas where the light field keeps them; sags[i] is g[i]'s.)
+                std::vector<Vec2f, UnwrittenAllocator<Vec2f>>& sagOf = local.sag;
+                if (lf.curved()) {
+                    if (sagOf.capacity() < largestTile) sagOf.reserve(largestTile);
+                    sagOf.resize(g.size());
+                }
+                Vec2f* const sags = lf.curved() ? sagOf.data() : nullptr;
                 // The slopes of each class, kept in registers while the samples are read (as
                 // range[cls].add(c) they went through memory, a store and a load per sample on
                 // the gather's critical path). A moving sample's class is 1 until the tile's
@@ -2350,8 +2362,7 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                             a.t = s.time();
                             a.mx = m.x;
                             a.my = m.y;
-                            a.sx = sag.x;
-                            a.sy = sag.y;
+                            if (sags) sags[next - g.data()] = sag;
                             a.cls = uint8_t(movesOnScreen(m) ? 1 : 0);
                             anyMoving |= a.cls != 0;
                             // slopeOf and the inverse depth from one division (the same values).
@@ -2482,7 +2493,7 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                         }
                     }
                 }
-                splitLayers(g, keyRange, rate, depthRate, splitRange, o, split, key);
+                splitLayers(g, sags, keyRange, rate, depthRate, splitRange, o, split, key);
                 std::vector<Layer>& layers = split.layers;
                 layerTotal += layers.size();
                 if (groups > 0) {
@@ -2932,11 +2943,13 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                 // Its own layer's N, D, W and radiance at its own trajectory's point. (A turning
                 // object's sample on its arc: only in a layer with a motion grid, whose rays and
                 // D follow the grid's sagittas.)
-                auto ownCellOf = [&](const Gathered& s, int sl) __attribute__((always_inline)) {  // (called in the splat: a call per sample cost 1% of conference AAF)
+                // (Of sample g[i], in layer sl.)
+                auto ownCellOf = [&](size_t i, int sl) __attribute__((always_inline)) {  // (called in the splat: a call per sample cost 1% of conference AAF)
+                    const Gathered& s = g[i];
                     const Layer& l = layers[size_t(sl)];
                     Vec2f own = layerPosition(s, l.sharp, s.c, s.mx, s.my, l.depthRate);
-                    if (!motionAcc[size_t(sl)].empty() && curved(s)) {
-                        const Vec2f shift = curvedShift(l.arc, {s.mx, s.my}, effectiveSag(s, l.depthRate), alongChord(s.t - 0.5f, l.depthRate), s.t);
+                    if (const Vec2f sag = sags ? sags[i] : Vec2f{0.f, 0.f}; !motionAcc[size_t(sl)].empty() && curved(sag)) {
+                        const Vec2f shift = curvedShift(l.arc, {s.mx, s.my}, effectiveSag(s, sag, l.depthRate), alongChord(s.t - 0.5f, l.depthRate), s.t);
                         own = {own.x + shift.x, own.y + shift.y};
                     }
                     const int ci = int(std::floor(own.x * l.invStep)) - l.gx0, cj = int(std::floor(own.y * l.invStep)) - l.gy0;  // (gridCell)
@@ -2955,7 +2968,7 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                         const Gathered& s = g[i];
                         const int sl = split.layerOf(s);
                         sampleLayer[i] = uint16_t(sl);
-                        const uint32_t c = ownCell[i] = ownCellOf(s, sl);
+                        const uint32_t c = ownCell[i] = ownCellOf(i, sl);
                         if (c == kOffGrid) continue;
                         const int ci = int(c & 0xffffu), cj = int(c >> 16);
                         CellBox& b = splatBox[size_t(sl)];
@@ -3030,14 +3043,14 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                 for (size_t i = 0; i < g.size(); ++i) {
                     const Gathered& s = g[i];
                     const int sl = windows ? int(sampleLayer[i]) : split.layerOf(s);
-                    const uint32_t own = windows ? ownCell[i] : ownCellOf(s, sl);
+                    const uint32_t own = windows ? ownCell[i] : ownCellOf(i, sl);
                     if (!windows) sampleLayer[i] = uint16_t(sl);
                     if (own == kOffGrid) continue;
                     const SplatTarget& l = target[size_t(sl)];
                     const int cx = int(own & 0xffffu), cy = int(own >> 16);
                     const int ci = cy * l.gw + cx, ai = l.accIndex(cx, cy), di = l.dIndex(cx, cy);  // (its index in the grid, in acc and in accD)
-                    if (l.motion && curved(s)) {
-                        const Vec2f e = effectiveSag(s, l.depthRate);
+                    if (const Vec2f sag = sags ? sags[i] : Vec2f{0.f, 0.f}; l.motion && curved(sag)) {
+                        const Vec2f e = effectiveSag(s, sag, l.depthRate);
                         std::vector<float>& sa = sagAcc[size_t(sl)];
                         if (sa.empty()) sa.assign(size_t(l.gw) * l.gh * 2, 0.f);
                         sa[size_t(ci) * 2] += e.x;
