@@ -193,10 +193,15 @@ inline float slopeOf(const LightFieldSample& s, const ViewGeometry& view) {
 
 /// The cell of a grid whose cell (i, j) covers the pixels [(gx0 + i) s, (gx0 + i + 1) s) x [(gy0
 /// + j) s, (gy0 + j + 1) s) (gw x gh cells, row-major; s the cell's size, 1 / inv pixels: Layer::
-/// step) that holds point p; -1 off the grid.
+/// step) that holds point p, as its column i and row j: whether p is on the grid.
+[[gnu::always_inline]] inline bool gridCellAt(int gx0, int gy0, int gw, int gh, Vec2f p, float inv, int& i, int& j) {
+    i = int(std::floor(p.x * inv)) - gx0, j = int(std::floor(p.y * inv)) - gy0;
+    return i >= 0 && j >= 0 && i < gw && j < gh;
+}
+/// ... as its index (row-major); -1 off the grid.
 inline int gridCell(int gx0, int gy0, int gw, int gh, Vec2f p, float inv = 1.f) {
-    const int i = int(std::floor(p.x * inv)) - gx0, j = int(std::floor(p.y * inv)) - gy0;
-    return i < 0 || j < 0 || i >= gw || j >= gh ? -1 : j * gw + i;
+    int i, j;
+    return gridCellAt(gx0, gy0, gw, gh, p, inv, i, j) ? j * gw + i : -1;
 }
 /// How far along its screen chord m (its motion from the shutter's open to its close) a point
 /// moving at constant velocity in space is at time s = t - 1/2 from where it is at mid-shutter,
@@ -368,6 +373,7 @@ struct CellBox {
         return {std::max(0, x0 - rx), std::max(0, y0 - ry), std::min(gw, x1 + rx), std::min(gh, y1 + ry)};
     }
     CellBox shifted(int dx, int dy) const { return {x0 + dx, y0 + dy, x1 + dx, y1 + dy}; }
+    bool contains(int i, int j) const { return i >= x0 && i < x1 && j >= y0 && j < y1; }
     CellBox united(const CellBox& b) const {
         if (empty()) return b;
         if (b.empty()) return *this;
@@ -561,7 +567,7 @@ struct Layer {
     /// The index in acc (times accStride) of the grid's cell (i, j), within accWin; in accD, within dWin.
     int accAt(int i, int j) const { return (j - accWin.y0) * (accWin.x1 - accWin.x0) + (i - accWin.x0); }
     int dAt(int i, int j) const { return (j - dWin.y0) * (dWin.x1 - dWin.x0) + (i - dWin.x0); }
-    bool inAcc(int i, int j) const { return i >= accWin.x0 && i < accWin.x1 && j >= accWin.y0 && j < accWin.y1; }
+    bool inAcc(int i, int j) const { return accWin.contains(i, j); }
     /// The index in `cell` of the grid's cell (i, j), or of the nearest one cellBox holds.
     size_t cellAt(int i, int j) const {
         const int w = cellBox.x1 - cellBox.x0;
@@ -634,7 +640,7 @@ struct Layer {
         // (Every cell beyond cellBox has alpha 0.)
         const int bw = cellBox.x1 - cellBox.x0;
         summedArea(gw, gh, covered, [&](int i, int j) {
-            return i >= cellBox.x0 && i < cellBox.x1 && j >= cellBox.y0 && j < cellBox.y1 &&
+            return cellBox.contains(i, j) &&
                    cell[(size_t(j - cellBox.y0) * size_t(bw) + size_t(i - cellBox.x0)) * size_t(cs)] > 0.f;
         });
         if (!emitCells.empty()) summedArea(gw, gh, emitting, [&](int i, int j) { return emitCells[size_t(j) * gw + i] != 0; });
@@ -2120,9 +2126,6 @@ float gridPad(const LayerOptions& o) { return std::ceil(3.f * o.sigmaMax) + 2.f;
 /// A gathered sample and its scratch: its sagitta where the light field keeps them (counted
 /// always), its layer (sampleLayer) and its cell (ownCell).
 constexpr uint64_t kGatheredBytes = sizeof(Gathered) + sizeof(Vec2f) + sizeof(uint16_t) + sizeof(uint32_t);
-}  // namespace
-
-namespace {
 /// The pixels of the largest region a tile gathers.
 uint64_t largestRegion(int width, int height, const LayerOptions& o) {
     // (A tile's margin is its trajectories' reach, at most maxReach, and the pad: reconstructLayers.)
@@ -2952,8 +2955,8 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                         const Vec2f shift = curvedShift(l.arc, {s.mx, s.my}, effectiveSag(s, sag, l.depthRate), alongChord(s.t - 0.5f, l.depthRate), s.t);
                         own = {own.x + shift.x, own.y + shift.y};
                     }
-                    const int ci = int(std::floor(own.x * l.invStep)) - l.gx0, cj = int(std::floor(own.y * l.invStep)) - l.gy0;  // (gridCell)
-                    return ci < 0 || cj < 0 || ci >= l.gw || cj >= l.gh ? kOffGrid : uint32_t(cj) << 16 | uint32_t(ci);
+                    int ci, cj;
+                    return gridCellAt(l.gx0, l.gy0, l.gw, l.gh, own, l.invStep, ci, cj) ? uint32_t(cj) << 16 | uint32_t(ci) : kOffGrid;
                 };
                 // Only in a tile with a blurred moving layer: a still layer's grid reaches at most
                 // stillGridReach cells beyond its tile, and on docs/bunny-near.json and conference
@@ -3159,8 +3162,8 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                     forEachBehind(k, wx0, wx1, wy0, wy1, [&](const Gathered& s, int sl) {
                         if (farthest[size_t(sl)] >= nearest && l.inFrontOfAll(s.invDepth, s.t)) return;
                         const Vec2f p = layerPosition(s, l.sharp, l.c, l.mx, l.my, l.depthRate);
-                        const int ci = int(std::floor(p.x * l.invStep)) - l.gx0, cj = int(std::floor(p.y * l.invStep)) - l.gy0;  // (gridCell)
-                        if (ci < 0 || cj < 0 || ci >= gw || cj >= gh || !near[size_t(cj) * gw + size_t(ci)]) return;
+                        int ci, cj;
+                        if (!gridCellAt(l.gx0, l.gy0, gw, gh, p, l.invStep, ci, cj) || !near[size_t(cj) * gw + size_t(ci)]) return;
                         l.d[l.dIndex(ci, cj)] += 1.f;  // (a cell `near` counts lies within dWin)
                     });
                 }
