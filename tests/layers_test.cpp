@@ -16,6 +16,7 @@
 #include "core/error.h"
 #include "core/light_field.h"
 #include "core/memory_limit.h"
+#include "core/parallel.h"
 #include "filter/layers.h"
 #include "metrics/metrics.h"
 #include "render/camera.h"
@@ -1272,20 +1273,15 @@ LightFieldSamples randomLightField(int w, int h, uint32_t spp, uint32_t seed, Sa
 
 }  // namespace
 
-TEST(Layers, ALayersGridsAreStoredOnlyAroundTheCellsItsSamplesReach) {
-    // Three small discs (radius 4 px) moving 90 px along x, one also 40 px down, over a far wall
-    // (slope -4 px) and a post in front (+5 px), each sample of its own random radiance. A moving
-    // layer's grid reaches as far as its motion each way, and its samples fill a streak of it:
-    // the stage stores each layer's accumulations and resolved cells only around the cells its
-    // samples reach (Layer::accWin, dWin, cellBox). The image must be the one of whole grids
-    // (LayerOptions::everyCell), to the bit, and far less must be stored.
-    const int W = 192, H = 128;
-    const ViewGeometry view = wideLensView(W, H);
+/// Three small discs (radius 4 px) moving 90 px along x, one also 40 px down, over a far wall
+/// (slope -4 px) and a post in front (+5 px), each sample of its own random radiance; 192 x 128
+/// pixels, 12 samples a pixel.
+LightFieldSamples threeMovingDiscs(const ViewGeometry& view) {
     const std::array<Vec2f, 3> centre{Vec2f{60.f, 30.f}, Vec2f{120.f, 64.f}, Vec2f{96.f, 80.f}};
     const std::array<Vec2f, 3> motion{Vec2f{90.f, 0.f}, Vec2f{-90.f, 0.f}, Vec2f{90.f, 40.f}};
     std::mt19937 colours(12);
     std::uniform_real_distribution<float> uni(0.f, 1.f);
-    const LightFieldSamples lf = randomLightField<true>(W, H, 12, 11, [&](int x, int y, Vec2f film, float t, Vec2f lens) {
+    return randomLightField<true>(view.width, view.height, 12, 11, [&](int x, int y, Vec2f film, float t, Vec2f lens) {
         const float fx = float(x) + film.x, fy = float(y) + film.y;
         const bool post = fx + 5.f * lens.x > 20.f && fx + 5.f * lens.x < 30.f;
         int disc = -1;
@@ -1295,6 +1291,17 @@ TEST(Layers, ALayersGridsAreStoredOnlyAroundTheCellsItsSamplesReach) {
         return LightFieldSample::pack(film, lens, t, depth, disc >= 0 ? motion[size_t(disc)] : Vec2f{0.f, 0.f}, Vec3f(1.f),
                                       Vec3f(uni(colours), uni(colours), uni(colours)), post ? 1 : 0);
     });
+}
+
+TEST(Layers, ALayersGridsAreStoredOnlyAroundTheCellsItsSamplesReach) {
+    // Three small discs moving 90 px (threeMovingDiscs). A moving layer's grid reaches as far as
+    // its motion each way, and its samples fill a streak of it: the stage stores each layer's
+    // accumulations and resolved cells only around the cells its samples reach (Layer::accWin,
+    // dWin, cellBox). The image must be the one of whole grids (LayerOptions::everyCell), to the
+    // bit, and far less must be stored.
+    const int W = 192, H = 128;
+    const ViewGeometry view = wideLensView(W, H);
+    const LightFieldSamples lf = threeMovingDiscs(view);
     filter::LayerOptions whole;
     whole.everyCell = true;
     filter::LayerStats stats, wholeStats;
@@ -1310,6 +1317,48 @@ TEST(Layers, ALayersGridsAreStoredOnlyAroundTheCellsItsSamplesReach) {
     EXPECT_LT(stats.gridShare, 0.25) << stats.gridShare;
     // (A tile's gathered samples and its motion grids are stored whole either way.)
     EXPECT_LT(stats.largestTileBytes, 0.75 * wholeStats.largestTileBytes) << stats.largestTileBytes << " " << wholeStats.largestTileBytes;
+}
+
+TEST(Layers, TilesWaitForTheGridsBudgetAndAnErrorSaysWhenOneTileExceedsIt) {
+    // Each tile reserves a bound of its grids from what the memory limit leaves
+    // (LayerOptions::memoryHeld, GridBudget in layers.cpp) before it allocates them. The grids
+    // must stay within their bound in every tile; with room for one and a half of the largest
+    // tile's bound on two threads, tiles wait for each other and the image is the one with no
+    // limit, to the bit; with less than the largest bound, the stage is a clear error.
+    const int W = 192, H = 128;
+    const ViewGeometry view = wideLensView(W, H);
+    const LightFieldSamples lf = threeMovingDiscs(view);
+    struct Restore {
+        ~Restore() { setMemoryLimit(0); }
+    } restore;
+    ThreadLimit threads(2);
+    filter::LayerOptions o;
+    o.memoryHeld = 1 << 20;  // (as if the caller held 1 MiB)
+    filter::LayerStats free;
+    const Image3f a = filter::reconstructLayers(filter::LayerInput{lf, view, {}}, o, &free);
+    EXPECT_EQ(free.tilesOverReserve, 0.0);
+    EXPECT_EQ(free.tilesWaited, 0.0);
+    ASSERT_GT(free.largestTileReserve, 0.0);
+    // (The limit less the budget: what the caller holds and the two threads' gathered samples.)
+    const uint64_t outside = memoryLimit() - uint64_t(free.gridBudget);
+    EXPECT_GT(outside, uint64_t(o.memoryHeld));
+    setMemoryLimit(outside + uint64_t(1.5 * free.largestTileReserve));
+    filter::LayerStats tight;
+    const Image3f b = filter::reconstructLayers(filter::LayerInput{lf, view, {}}, o, &tight);
+    EXPECT_EQ(tight.tilesOverReserve, 0.0);
+    EXPECT_NEAR(tight.gridBudget, 1.5 * free.largestTileReserve, 1.0);
+    for (int y = 0; y < H; ++y)
+        for (int x = 0; x < W; ++x) ASSERT_EQ(std::memcmp(&a(x, y), &b(x, y), sizeof(Vec3f)), 0) << x << ", " << y;
+    setMemoryLimit(outside + uint64_t(0.9 * free.largestTileReserve));
+    try {
+        filter::reconstructLayers(filter::LayerInput{lf, view, {}}, o);
+        ADD_FAILURE() << "no error with a budget below the largest tile's bound";
+    } catch (const Error& e) {
+        const std::string m = e.what();
+        EXPECT_NE(m.find("--layers: the layers' tile at ("), std::string::npos) << m;
+        EXPECT_NE(m.find("beside the render's 1.0 MiB and 2 threads' gathered samples"), std::string::npos) << m;
+        EXPECT_NE(m.find("more than the memory limit of"), std::string::npos) << m;
+    }
 }
 
 TEST(Layers, TheSamplesATileGathersAreWithinWhatTheMemoryCheckCounts) {

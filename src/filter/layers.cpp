@@ -5,12 +5,17 @@
 #include <cassert>
 #include <climits>
 #include <cmath>
+#include <condition_variable>
+#include <mutex>
+#include <string>
 #include <type_traits>
 #include <vector>
 
 #include <tbb/enumerable_thread_specific.h>
 
+#include "core/error.h"
 #include "core/memory.h"
+#include "core/memory_limit.h"
 #include "core/parallel.h"
 #include "core/sampler.h"
 #include "filter/maaf.h"  // dilateBox
@@ -2132,6 +2137,52 @@ uint64_t largestRegion(int width, int height, const LayerOptions& o) {
     const int margin = int(std::ceil(float(o.maxReach) + gridPad(o)));
     return uint64_t(std::min(width, o.tile + 2 * margin)) * uint64_t(std::min(height, o.tile + 2 * margin));
 }
+
+/// The memory the tiles' grids may hold at once, over every thread (LayerOptions::memoryHeld):
+/// a tile reserves a bound of its grids before it allocates them (all of it at once, so that no
+/// thread waits while it holds a part) and releases it when they are freed. A tile that does not
+/// fit beside what the other threads' tiles hold waits for them; one that needs more than the
+/// whole budget is an error. Waiting changes no image: a tile's work is the same whenever it runs.
+class GridBudget {
+public:
+    GridBudget(uint64_t budget, uint64_t held, uint64_t gathered, int threads)
+        : m_budget(budget), m_held0(held), m_gathered(gathered), m_threads(threads) {}
+    uint64_t budget() const { return m_budget; }
+    /// Reserves `bytes` for the tile whose pixels start at (x, y), waiting while other tiles hold
+    /// too much; throws wedge::Error where `bytes` exceed the whole budget.
+    void reserve(uint64_t bytes, int x, int y) {
+        if (bytes > m_budget)
+            throw Error("--layers", overMemoryLimit("the layers' tile at (" + std::to_string(x) + ", " + std::to_string(y) + "), with its grids (" +
+                                                        formatBytes(double(bytes)) + ") beside the render's " + formatBytes(double(m_held0)) +
+                                                        " and " + (m_threads == 1 ? std::string("1 thread's") : std::to_string(m_threads) + " threads'") + " gathered samples (" +
+                                                        formatBytes(double(m_gathered)) + "),",
+                                                    m_held0 + m_gathered + bytes) +
+                                        (m_threads > 1 ? "; fewer --threads, or --layers off, need less" : "; --layers off needs less"));
+        std::unique_lock<std::mutex> lock(m_mutex);
+        if (m_held > 0 && m_held + bytes > m_budget) {
+            ++m_waited;
+            m_freed.wait(lock, [&] { return m_held == 0 || m_held + bytes <= m_budget; });
+        }
+        m_held += bytes;
+        m_most = std::max(m_most, bytes);
+    }
+    void release(uint64_t bytes) {
+        {
+            std::lock_guard<std::mutex> lock(m_mutex);
+            m_held -= bytes;
+        }
+        m_freed.notify_all();
+    }
+    uint64_t waited() const { return m_waited; }
+    uint64_t most() const { return m_most; }
+
+private:
+    const uint64_t m_budget, m_held0, m_gathered;
+    const int m_threads;
+    std::mutex m_mutex;
+    std::condition_variable m_freed;
+    uint64_t m_held = 0, m_waited = 0, m_most = 0;
+};
 }  // namespace
 
 uint64_t gatheredSamplesPerThread(int width, int height, double samplesPerPixel, const LayerOptions& o) {
@@ -2297,6 +2348,13 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
         std::vector<int> occupiedStill;     // the D pass of the other layers: a layer's cells with samples summed over rectangles,
         std::vector<uint8_t> near;          // ... and its cells within the margin of one
     };
+    // The grids' budget: the memory limit less what the caller holds and every thread's gathered
+    // samples (GridBudget).
+    const int threads = std::max(1, ThreadLimit::current());
+    const uint64_t gatheredHeld = uint64_t(threads) * (uint64_t(largestTile) * kGatheredBytes + (largestRegion(W, H, o) + 1) * sizeof(uint32_t));
+    const uint64_t limit = memoryLimit(), outside = o.memoryHeld + gatheredHeld;
+    GridBudget budget(limit > outside ? limit - outside : 0, o.memoryHeld, gatheredHeld, threads);
+    std::atomic<uint64_t> overReserve{0};
     tbb::enumerable_thread_specific<Scratch> scratch;
     parallelTiles(tilesX, tilesY, 1, [&](int tx0, int tx1, int ty0, int ty1) {
         Scratch& local = scratch.local();
@@ -2304,6 +2362,22 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
         Split& split = local.split;
         for (int ty = ty0; ty < ty1; ++ty)
             for (int tx = tx0; tx < tx1; ++tx) {
+                // The tile's reservation from the grids' budget (GridBudget), given back once its
+                // layers' grids are freed: at the end of the tile, or where it throws.
+                struct Reservation {
+                    GridBudget& budget;
+                    std::vector<Layer>& layers;
+                    uint64_t bytes = 0;
+                    void reserve(uint64_t b, int x, int y) {
+                        budget.reserve(b, x, y);
+                        bytes = b;
+                    }
+                    ~Reservation() {
+                        if (bytes == 0) return;
+                        layers.clear();
+                        budget.release(bytes);
+                    }
+                } reserved{budget, split.layers};
                 // The pixels left to the method (LayerInput::methodPixels): own, and no ray. The
                 // tile's work is the box of the others (its grids, and the samples it gathers:
                 // a silhouette through one corner of the tile needs that corner); a tile of them
@@ -2875,22 +2949,20 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                             t.c = l.c, t.moving = l.moving;  // (radianceOf's and resolveCells' reads)
                             t.sharp = true, t.timeBins = 1;
                             t.gx0 = X0, t.gy0 = Y0, t.gw = X1 - X0, t.gh = Y1 - Y0;
-                            t.accWin = t.dWin = {0, 0, t.gw, t.gh};
-                            t.acc.assign(size_t(t.gw) * t.gh * t.accStride(), 0.f);
-                            t.accD.assign(size_t(t.gw) * t.gh, 0.f);
+                            t.accWin = t.dWin = {0, 0, t.gw, t.gh};  // (acc and accD: below, with the layers')
                         }
                     }
                 }
                 blurredTotal += anyBlurred ? 1 : 0;
                 // Splat: N and D at the layer's shear, W and the radiance at the sample's own.
+                // (Per layer, whether it has a motion grid: its sums are allocated with the
+                // accumulations, below.)
                 bool anyMotionGrid = false;
                 std::vector<std::vector<float>> motionAcc(layers.size());
                 std::vector<std::vector<float>> sagAcc(layers.size());  // per cell: the sums of the effective sagittas (Layer::sagGrid)
+                std::vector<uint8_t> hasMotionGrid(layers.size(), 0);
                 for (size_t k = 0; k < layers.size(); ++k)
-                    if (layers[k].moving && !layers[k].sharp && layers[k].motionScale > 0.f) {
-                        motionAcc[k].assign(size_t(layers[k].gw) * layers[k].gh * 3, 0.f);
-                        anyMotionGrid = true;
-                    }
+                    if (layers[k].moving && !layers[k].sharp && layers[k].motionScale > 0.f) hasMotionGrid[k] = 1, anyMotionGrid = true;
                 // What the splat reads of each layer, packed (the Layer is hundreds of bytes, and
                 // every sample visits every layer in front of its own); a moving layer with a
                 // motion grid (`motion`) takes its D in the pass below.
@@ -2912,7 +2984,7 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                     std::vector<std::array<float, 2>> most(layers.size(), {-1.f, -1.f});
                     for (size_t k = 0; k < layers.size(); ++k) {
                         const Layer& l = layers[k];
-                        if (!motionAcc[k].empty() && l.step == 1 && std::max(std::abs(l.cMin), std::abs(l.cMax)) <= kCrispSlope) most[k] = {0.f, 0.f};
+                        if (hasMotionGrid[k] && l.step == 1 && std::max(std::abs(l.cMin), std::abs(l.cMax)) <= kCrispSlope) most[k] = {0.f, 0.f};
                     }
                     for (const Gathered& s : g) {
                         std::array<float, 2>& m = most[size_t(split.layerOf(s))];
@@ -2951,7 +3023,7 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                     const Gathered& s = g[i];
                     const Layer& l = layers[size_t(sl)];
                     Vec2f own = layerPosition(s, l.sharp, s.c, s.mx, s.my, l.depthRate);
-                    if (const Vec2f sag = sags ? sags[i] : Vec2f{0.f, 0.f}; !motionAcc[size_t(sl)].empty() && curved(sag)) {
+                    if (const Vec2f sag = sags ? sags[i] : Vec2f{0.f, 0.f}; hasMotionGrid[size_t(sl)] && curved(sag)) {
                         const Vec2f shift = curvedShift(l.arc, {s.mx, s.my}, effectiveSag(s, sag, l.depthRate), alongChord(s.t - 0.5f, l.depthRate), s.t);
                         own = {own.x + shift.x, own.y + shift.y};
                     }
@@ -2997,9 +3069,47 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                         l.accWin = b.grown(ra, ra, l.gw, l.gh);
                         l.dWin = b.grown(rd, rd, l.gw, l.gh);
                     }
-                    auto cellsOf = [](const CellBox& w) { return w.empty() ? size_t(0) : size_t(w.x1 - w.x0) * size_t(w.y1 - w.y0); };
-                    l.acc.assign(cellsOf(l.accWin) * size_t(l.accStride()), 0.f);
-                    l.accD.assign(cellsOf(l.dWin), 0.f);
+                }
+                // The grids' bound, reserved from the budget before they are allocated, and the
+                // grids allocated.
+                auto cellsOf = [](const CellBox& w) { return w.empty() ? uint64_t(0) : uint64_t(w.x1 - w.x0) * uint64_t(w.y1 - w.y0); };
+                {
+                    // Per layer: its accumulations; its resolved cells (within dWin and a ring:
+                    // resolveCells); a moving layer's motion sums, motion grid and window, and a
+                    // turning one's sagittas (where the light field keeps them); the summed-area
+                    // tables of its covered cells and, where the tile's samples see an emitter,
+                    // its emitters' cells; and the scratch the D passes fill for it. Per twin, its
+                    // grids and the blend its layer keeps (own).
+                    constexpr uint64_t F = sizeof(float), I = sizeof(int);
+                    uint64_t bound = uint64_t(layers.capacity() + twins.capacity()) * sizeof(Layer), scratchD = 0;
+                    for (size_t k = 0; k < layers.size(); ++k) {
+                        const Layer& l = layers[k];
+                        const uint64_t cells = uint64_t(l.gw) * uint64_t(l.gh), sat = uint64_t(l.gw + 1) * uint64_t(l.gh + 1);
+                        bound += (cellsOf(l.accWin) * uint64_t(l.accStride()) + cellsOf(l.dWin)) * F;
+                        bound += std::max<uint64_t>(1, cellsOf(l.dWin.empty() ? l.dWin : l.dWin.grown(1, 1, l.gw, l.gh))) * uint64_t(l.cellStride()) * F;
+                        bound += sat * I;
+                        if (anyEmitting && !l.sharp) bound += sat * I + cells;
+                        if (hasMotionGrid[k]) {
+                            bound += cells * 5 * F + uint64_t((l.gw + Layer::kWindowBlock - 1) / Layer::kWindowBlock) *
+                                                      uint64_t((l.gh + Layer::kWindowBlock - 1) / Layer::kWindowBlock) * 4 * F;
+                            bound += uint64_t(l.accWin.x1 - l.accWin.x0 + 1) * uint64_t(l.accWin.y1 - l.accWin.y0 + 1) * I;  // (occupied)
+                            if (sags) bound += cells * 4 * F;
+                        } else {
+                            scratchD = std::max(scratchD, sat * I + cells);  // (occupiedStill, near)
+                        }
+                    }
+                    for (const Layer& t : twins) bound += uint64_t(t.gw) * uint64_t(t.gh) * uint64_t(t.accStride() + 1 + t.cellStride() + 5) * F;
+                    reserved.reserve(bound + scratchD, X0, Y0);
+                }
+                for (size_t k = 0; k < layers.size(); ++k) {
+                    Layer& l = layers[k];
+                    l.acc.assign(size_t(cellsOf(l.accWin)) * size_t(l.accStride()), 0.f);
+                    l.accD.assign(size_t(cellsOf(l.dWin)), 0.f);
+                    if (hasMotionGrid[k]) motionAcc[k].assign(size_t(l.gw) * l.gh * 3, 0.f);
+                }
+                for (Layer& t : twins) {
+                    t.acc.assign(size_t(t.gw) * t.gh * t.accStride(), 0.f);
+                    t.accD.assign(size_t(t.gw) * t.gh, 0.f);
                 }
                 std::vector<SplatTarget> target(layers.size());
                 for (size_t k = 0; k < layers.size(); ++k) {
@@ -3451,6 +3561,14 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
                 // A layer a pixel's rays can see; a sharp still layer is the same for every ray
                 // (its pixel's cell), looked up once.
                 gridFloats += tileFloats, wholeGridFloats += tileWhole;
+                {
+                    // (LayerStats::tilesOverReserve: what the grids came to against their bound,
+                    // but the D passes' scratch.)
+                    uint64_t grids = tileBytes - uint64_t(g.size()) * sizeof(Gathered) + uint64_t(layers.capacity() + twins.capacity()) * sizeof(Layer);
+                    for (const Layer& l : layers) grids += (l.windowBlocks.size() + l.own.size()) * sizeof(float);
+                    for (const Layer& t : twins) grids += (t.acc.capacity() + t.accD.capacity() + t.cell.size()) * sizeof(float);
+                    if (grids > reserved.bytes) ++overReserve;
+                }
                 for (uint64_t most = largestTileBytes.load(); tileBytes > most && !largestTileBytes.compare_exchange_weak(most, tileBytes);) {
                 }
                 struct Active {
@@ -3792,6 +3910,10 @@ Image3f reconstructLayers(const LayerInput& in, const LayerOptions& o, LayerStat
         stats->largestTileBytes = double(largestTileBytes);
         stats->gridShare = wholeGridFloats > 0 ? double(gridFloats) / double(wholeGridFloats) : 0.0;
         stats->largestTileSamples = double(largestTile);
+        stats->largestTileReserve = double(budget.most());
+        stats->tilesOverReserve = double(overReserve);
+        stats->tilesWaited = double(budget.waited());
+        stats->gridBudget = double(budget.budget());
     }
     return out;
 }

@@ -192,6 +192,13 @@ struct LayerOptions {
     // Layers.TheCellsBeyondALayersAccumulationsChangeNoImage and
     // Layers.RaysOutsideAMovingLayersWindowFindNothingThere.
     bool everyCell = false;
+    // Bytes the caller holds beside the stage while it runs (the render's buffers and the kept
+    // samples). With each thread's gathered samples (the largest tile's) they are taken from the
+    // memory limit (core/memory_limit.h); what is left is the grids' budget: a tile reserves a
+    // bound of its grids before it allocates them and gives it back when they are freed, waits
+    // while the other threads' tiles hold too much of it, and is an error (wedge::Error, "--layers")
+    // where it needs more than all of it (docs/layers.md, "The grids' budget").
+    uint64_t memoryHeld = 0;
     // A blurred moving layer whose samples move along one axis of the grid, in focus (slopes
     // within 0.75 px), keeps the other axis crisp: the rays' lookup there the nearest cell, the
     // pixel's own row (column) of samples, no Gaussian across the motion for the coverage, the
@@ -284,6 +291,13 @@ struct LayerStats {
     // The samples the largest tile gathered (its pixels and its margins), which each thread
     // reserves once (gatheredBytesPerThread bounds it).
     double largestTileSamples = 0;
+    // The largest bound a tile reserved for its grids (LayerOptions::memoryHeld), bytes; the
+    // tiles whose grids came to more than their bound (none: layers_test checks it); the tiles
+    // that waited for the budget; and the budget.
+    double largestTileReserve = 0;
+    double tilesOverReserve = 0;
+    double tilesWaited = 0;
+    double gridBudget = 0;
 };
 
 /// The most samples one tile of reconstructLayers gathers: a tile and its widest margins
@@ -291,8 +305,8 @@ struct LayerStats {
 /// pixel.
 uint64_t gatheredSamplesPerThread(int width, int height, double samplesPerPixel, const LayerOptions& options = {});
 /// ... what a thread holds for them, bytes, with each sample's scratch. (The tile's grids come on
-/// top and depend on the scene: LayerStats::largestTileBytes; docs/layers.md, "Memory per
-/// thread".)
+/// top and depend on the scene: the stage reserves them from what the memory limit leaves,
+/// LayerOptions::memoryHeld; LayerStats::largestTileBytes.)
 uint64_t gatheredBytesPerThread(int width, int height, double samplesPerPixel, const LayerOptions& options = {});
 
 /// Whether every sample pixel `p` holds is sharp and still: its defocus blur, a disc of radius

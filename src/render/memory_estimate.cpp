@@ -25,6 +25,8 @@ constexpr uint64_t kLightFieldSampleBytes = sizeof(LightFieldSample);
 
 }  // namespace
 
+uint64_t bufferBytes(int width, int height) { return uint64_t(std::max(0, width)) * uint64_t(std::max(0, height)) * kRenderBytesPerPixel; }
+
 RenderMemory renderMemory(const scene::SceneDesc& desc, const RenderOptions& options) {
     const uint64_t pixels = uint64_t(desc.camera.width) * uint64_t(desc.camera.height);
     const int spp = renderSpp(desc, options);
@@ -41,8 +43,10 @@ RenderMemory renderMemory(const scene::SceneDesc& desc, const RenderOptions& opt
         perPixel += uint64_t(spp) * (kLightFieldSampleBytes + (keepsSags(desc) ? sizeof(LightFieldSag) : 0)) +
                     3 * sizeof(float);  // and LightFieldSamples::bentReach and the emissions
         m.what += " keeping its " + std::to_string(spp) + " samples a pixel for the layers (--layers)";
-        // ... and each thread the samples one tile gathers, a tile and its widest margins (not
-        // the tile's grids, which depend on the scene: docs/layers.md, "Memory per thread").
+        // ... and each thread the samples one tile gathers, a tile and its widest margins. (Not
+        // the tiles' grids, which depend on the scene: the stage reserves them tile by tile from
+        // what the limit leaves, filter::LayerOptions::memoryHeld; docs/layers.md, "The grids'
+        // budget".)
         threadBytes = filter::gatheredBytesPerThread(desc.camera.width, desc.camera.height, spp);
     }
     m.bytes = pixels * perPixel + uint64_t(std::max(1, ThreadLimit::current())) * threadBytes;

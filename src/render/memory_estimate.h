@@ -20,6 +20,11 @@ struct RenderMemory {
 };
 RenderMemory renderMemory(const scene::SceneDesc& desc, const RenderOptions& options);
 
+/// The render's buffers beside the samples the layers keep, for a width x height image: what
+/// renderMemory counts a pixel (the layers' stage takes its grids' budget from the memory limit
+/// less these and the kept samples: filter::LayerOptions::memoryHeld).
+uint64_t bufferBytes(int width, int height);
+
 /// Throws wedge::Error naming the scene file when renderMemory's bytes exceed the memory limit.
 void checkRenderMemory(const scene::SceneDesc& desc, const RenderOptions& options);
 

@@ -11,6 +11,7 @@
 #include "filter/layers.h"
 #include "filter/maaf.h"
 #include "render/distribution.h"
+#include "render/memory_estimate.h"
 #include "render/methods.h"
 #include "render/sampling.h"
 
@@ -380,6 +381,9 @@ Image3f reconstructFromLayers(const MethodContext& ctx,
     const FrameBuffers& fb = result.buffers;
     filter::LayerOptions lo;
     lo.seed = ctx.sampler.seed();
+    // What the render holds beside the stage: its buffers and the samples it keeps (the grids'
+    // budget is the memory limit less these and the threads' gathered samples).
+    lo.memoryHeld = bufferBytes(fb.width, fb.height) + ctx.lightField->bytes();
     // Samples that carry their own radiance (mc) are as noisy as a pixel's few samples: there a
     // near-focus layer (true blur at least half the grid's own at 16 samples per pixel, all of
     // it from 64) is reconstructed from the samples of its neighbourhood rather than its
@@ -481,6 +485,10 @@ Image3f reconstructFromLayers(const MethodContext& ctx,
     result.extra.emplace_back("layers_rays_per_pixel", stats.raysPerPixel);
     result.extra.emplace_back("layers_largest_tile_bytes", stats.largestTileBytes);
     result.extra.emplace_back("layers_grid_share", stats.gridShare);
+    result.extra.emplace_back("layers_largest_tile_reserve", stats.largestTileReserve);
+    result.extra.emplace_back("layers_tiles_over_reserve", stats.tilesOverReserve);
+    result.extra.emplace_back("layers_tiles_waited", stats.tilesWaited);
+    result.extra.emplace_back("layers_grid_budget", stats.gridBudget);
     if (input.methodPixels) result.extra.emplace_back("layers_method_tiles", stats.methodTiles);
     if (perPixel)
         result.extra.emplace_back("layers_own_pixels", double(ownPixels) / double(std::max<size_t>(1, size_t(fb.width) * fb.height)));
